@@ -1,0 +1,249 @@
+/* libmpmc: explicit material point method with the assumed deformation gradient (F-bar)
+ * of Zhao, Jiang & Choo (2023).  The only public header.
+ *
+ * Conventions: every function returns an int error code, 0 (MPMC_SUCCESS) on success;
+ * the context records a human-readable message for the last failure
+ * (mpmc_context_last_error).  Handles are opaque.  destroy() takes the handle's address,
+ * accepts NULL and sets the handle to NULL.  Units are SI throughout.
+ * Stress is stored in Voigt order (xx, yy, zz, yz, xz, xy), tension positive.
+ */
+#ifndef MPMC_H
+#define MPMC_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MPMC_VERSION_MAJOR 0
+#define MPMC_VERSION_MINOR 1
+#define MPMC_VERSION_PATCH 0
+
+/* Error codes and their messages, defined once (enum and mpmc_error_string). */
+#define MPMC_ERROR_LIST(X)                                                        \
+  X(MPMC_SUCCESS, "success")                                                      \
+  X(MPMC_ERR_ARG, "invalid argument")                                             \
+  X(MPMC_ERR_MEMORY, "out of memory")                                             \
+  X(MPMC_ERR_STATE, "call out of order")                                          \
+  X(MPMC_ERR_OUTSIDE, "material point outside the grid")                          \
+  X(MPMC_ERR_NUMERIC, "numerical failure (NaN, Inf or inverted volume)")          \
+  X(MPMC_ERR_UNSTABLE, "time step above the stability limit")                     \
+  X(MPMC_ERR_SOLVER, "local solver did not converge")                             \
+  X(MPMC_ERR_IO, "input/output error")                                            \
+  X(MPMC_ERR_FORMAT, "malformed or incompatible file")                            \
+  X(MPMC_ERR_UNSUPPORTED, "not supported in this build")
+
+#define MPMC_ERROR_ENUM_(name, msg) name,
+typedef enum { MPMC_ERROR_LIST(MPMC_ERROR_ENUM_) MPMC_ERROR_COUNT } mpmc_error;
+#undef MPMC_ERROR_ENUM_
+
+typedef struct mpmc_context_s *mpmc_context;
+typedef struct mpmc_sim_s *mpmc_sim;
+
+typedef enum {
+  MPMC_LOG_SILENT = 0,
+  MPMC_LOG_ERROR = 1,
+  MPMC_LOG_WARNING = 2,
+  MPMC_LOG_INFO = 3,
+  MPMC_LOG_DEBUG = 4
+} mpmc_log_level;
+
+typedef enum {
+  MPMC_BASIS_LINEAR = 0,   /* standard MPM hat functions                         */
+  MPMC_BASIS_UGIMP = 1,    /* GIMP with the particle domain fixed at its initial size */
+  MPMC_BASIS_BSPLINE2 = 2, /* quadratic B-spline                                  */
+  MPMC_BASIS_BSPLINE3 = 3  /* cubic B-spline                                      */
+} mpmc_basis;
+
+typedef enum {
+  MPMC_WALL_FIXED = 0,    /* every velocity component zero                      */
+  MPMC_WALL_SLIP = 1,     /* normal component zero (roller), tangential free     */
+  MPMC_WALL_SEPARABLE = 2 /* normal component may only point away from the wall  */
+} mpmc_wall_kind;
+
+typedef enum {
+  MPMC_SOLVER_AUTO = 0,   /* scalar Newton, KINSOL where Newton is unsafe        */
+  MPMC_SOLVER_NEWTON = 1, /* safeguarded scalar Newton only                      */
+  MPMC_SOLVER_KINSOL = 2  /* SUNDIALS KINSOL with line search only               */
+} mpmc_solver;
+
+/* Particle fields, readable (and writable) in place.  ncomp per particle in brackets. */
+typedef enum {
+  MPMC_FIELD_POSITION = 0, /* [dim]                                                  */
+  MPMC_FIELD_VELOCITY = 1, /* [dim]                                                  */
+  MPMC_FIELD_MASS = 2,     /* [1]                                                    */
+  MPMC_FIELD_VOLUME0 = 3,  /* [1] initial volume (plane strain: per unit thickness)  */
+  MPMC_FIELD_J = 4,        /* [1] det F; current volume = J * volume0 (eq 15)        */
+  MPMC_FIELD_JBAR = 5,     /* [1] det F-bar (only with F-bar on)                     */
+  MPMC_FIELD_STRESS = 6,   /* [6] Cauchy stress, Voigt xx yy zz yz xz xy             */
+  MPMC_FIELD_BE = 7,       /* [6] elastic left Cauchy-Green tensor, Voigt            */
+  MPMC_FIELD_EPS_P = 8,    /* [1] equivalent plastic strain (plastic materials only) */
+  MPMC_FIELD_FORCE = 9,    /* [dim] external force on the particle (tractions)      */
+  MPMC_FIELD_X0 = 10,      /* [dim] initial position                                 */
+  MPMC_FIELD_COUNT = 11
+} mpmc_field;
+
+/* Run statistics, accumulated since creation. */
+typedef struct {
+  int64_t steps;
+  double time;
+  int64_t particle_steps;
+  int64_t return_maps;       /* plastic corrections computed                        */
+  int64_t kinsol_fallbacks;  /* return maps the auto solver handed to KINSOL        */
+  double wall_seconds;       /* inside mpmc_sim_step                                */
+} mpmc_stats;
+
+/* ---- errors and context ------------------------------------------------------ */
+const char *mpmc_error_string(int code);
+int mpmc_context_create(mpmc_context *ctx);
+int mpmc_context_destroy(mpmc_context *ctx);
+const char *mpmc_context_last_error(const mpmc_context ctx);
+int mpmc_context_get_last_error(const mpmc_context ctx, char *buf, int len);
+int mpmc_context_clear_error(mpmc_context ctx);
+int mpmc_context_set_log_level(mpmc_context ctx, int level);
+int mpmc_version(int *major, int *minor, int *patch);
+
+/* ---- simulation set-up ----------------------------------------------------- */
+int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim);
+int mpmc_sim_destroy(mpmc_sim *sim);
+int mpmc_sim_get_context(const mpmc_sim sim, mpmc_context *ctx);
+int mpmc_sim_get_dim(const mpmc_sim sim, int *dim);
+/* Uniform grid covering the box [lo, hi] with cells of size h; (hi - lo)/h is rounded up
+ * to whole cells.  Ghost layers outside the box are added internally so that every basis
+ * has full support for material points inside the box. */
+int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h);
+int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h);
+int mpmc_sim_set_basis(mpmc_sim sim, int basis);
+int mpmc_sim_set_fbar(mpmc_sim sim, int enabled);
+int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled);
+int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
+int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
+int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
+int mpmc_sim_set_solver(mpmc_sim sim, int solver);
+int mpmc_sim_set_threads(mpmc_sim sim, int nthreads);
+
+/* ---- materials; each returns its id ----------------------------------------- */
+int mpmc_sim_add_material_neo_hookean(mpmc_sim sim, double E, double nu, double rho, int *id);
+int mpmc_sim_add_material_hencky(mpmc_sim sim, double E, double nu, double rho, int *id);
+/* Hencky elasticity + von Mises (J2) plasticity with exponential softening:
+ * q = sqrt(3/2)|dev tau| <= kappa(eps_p) = kappa_r + (kappa_p - kappa_r) exp(-eta eps_p). */
+int mpmc_sim_add_material_hencky_j2(mpmc_sim sim, double E, double nu, double rho,
+                                    double kappa_p, double kappa_r, double eta, int *id);
+/* Nearly incompressible Newtonian fluid: p = -K (J - 1), deviatoric 2 mu dev(D). */
+int mpmc_sim_add_material_newtonian(mpmc_sim sim, double K, double mu, double rho, int *id);
+int mpmc_sim_get_num_materials(const mpmc_sim sim, int *n);
+/* Divide the yield strengths (kappa_p and kappa_r) of a plastic material by factor;
+ * material = -1 for every plastic material.  Accumulated plastic strain is kept. */
+int mpmc_sim_reduce_strength(mpmc_sim sim, int material, double factor);
+
+/* ---- material points ------------------------------------------------------- */
+/* Copies n points: x[n*dim] positions, volume[n] volumes (per unit thickness in 2D).
+ * Mass = rho * volume.  *first (may be NULL) receives the index of the first new point. */
+int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *volume,
+                           int material, int *first);
+int mpmc_sim_get_num_particles(const mpmc_sim sim, int *n);
+/* Borrow a particle field in place (no copy); give it back with restore.  Fields a scene
+ * does not have (e.g. EPS_P without a plastic material) are MPMC_ERR_STATE. */
+int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp);
+int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data);
+int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids);
+/* External force on points [first, first+n): f[n*dim] (a traction times its tributary
+ * length or area).  Allocates the force field on first use. */
+int mpmc_sim_set_particle_forces(mpmc_sim sim, int first, int n, const double *f);
+
+/* ---- boundary conditions on the grid ------------------------------------------ */
+/* A wall constrains every grid node on or beyond the plane x[axis] = position:
+ * side = -1 constrains nodes with x[axis] <= position (material on the + side),
+ * side = +1 nodes with x[axis] >= position. */
+int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, int kind, int *id);
+/* A wall on a face of the grid box: face = 2*axis + (0 for lo, 1 for hi). */
+int mpmc_sim_add_wall_face(mpmc_sim sim, int face, int kind, int *id);
+/* Constrain the nodes inside the axis-aligned box [lo, hi] (gates, obstacles);
+ * for SLIP and SEPARABLE the constrained component is `axis`, with material on side
+ * -side (side -1: material is at larger x[axis]). */
+int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, int kind, int axis,
+                          int side, int *id);
+int mpmc_sim_remove_wall(mpmc_sim sim, int id);
+
+/* ---- time stepping ---------------------------------------------------------- */
+/* dt = factor * h / max_p(c_p + |v_p|), c_p the p-wave speed (paper: factor 0.3-0.4). */
+int mpmc_sim_stable_dt(mpmc_sim sim, double factor, double *dt);
+/* One explicit step (paper Fig. 1 / Algorithm 1).  Refuses a dt above the stability limit
+ * h / c unless mpmc_sim_set_force_dt(sim, 1). */
+int mpmc_sim_step(mpmc_sim sim, double dt);
+int mpmc_sim_set_force_dt(mpmc_sim sim, int force);
+int mpmc_sim_get_time(const mpmc_sim sim, double *t);
+int mpmc_sim_set_time(mpmc_sim sim, double t);
+int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke);
+int mpmc_sim_get_stats(const mpmc_sim sim, mpmc_stats *stats);
+
+/* ---- named particle sets (sets.c) ---------------------------------------------- */
+/* Sets name groups of points (gmsh boundary groups, traction edges, tracked points).
+ * Adding a set with an existing name replaces it.  Indices are copied. */
+int mpmc_sim_add_particle_set(mpmc_sim sim, const char *name, int n, const int *idx, int *id);
+int mpmc_sim_get_num_particle_sets(const mpmc_sim sim, int *n);
+/* Borrow set `id`: its name, size and indices (valid until the sets change). */
+int mpmc_sim_get_particle_set(const mpmc_sim sim, int id, const char **name, int *n,
+                              const int **idx);
+int mpmc_sim_find_particle_set(const mpmc_sim sim, const char *name, int *id);
+
+/* ---- seeding without gmsh (seed.c) --------------------------------------------- */
+/* ppc points per cell per axis on the sim's grid lattice, kept where they fall inside
+ * the region; volume (h/ppc)^dim each.  *first / *count may be NULL. */
+int mpmc_sim_seed_box(mpmc_sim sim, const double *lo, const double *hi, int ppc, int material,
+                      int *first, int *count);
+/* 2D: a simple polygon given by nvert vertices xy[2*nvert] (either orientation). */
+int mpmc_sim_seed_polygon(mpmc_sim sim, int nvert, const double *xy, int ppc, int material,
+                          int *first, int *count);
+
+/* ---- seeding from gmsh (seed_gmsh.c, in the separate library libmpmc_gmsh) ---------- */
+typedef enum {
+  MPMC_SEED_LATTICE = 0,   /* ppc points per cell per axis on the grid, kept inside the mesh */
+  MPMC_SEED_QUADRATURE = 1 /* points at the elements' quadrature points (ppc = order)        */
+} mpmc_seed_mode;
+/* Mesh a .geo (or read a .msh) and add points for the physical group `region` (surface in
+ * 2D, volume in 3D).  Points near the boundary physical groups (curves in 2D, surfaces in
+ * 3D) and physical point groups become particle sets named after the groups. */
+int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
+                   int material, int *first, int *count);
+
+/* ---- output: HDF5 snapshots + XDMF (io_hdf5.c, io_xdmf.c) ------------------------ */
+typedef struct mpmc_output_s *mpmc_output;
+/* Create (truncate) h5path and write xdmfpath next to it on every snapshot. */
+int mpmc_output_create(mpmc_sim sim, const char *h5path, const char *xdmfpath, mpmc_output *out);
+/* Append one snapshot of the fields the scene has, at the current time. */
+int mpmc_output_write(mpmc_output out);
+int mpmc_output_destroy(mpmc_output *out);
+
+/* ---- checkpoint and restart (checkpoint.c) ------------------------------------------ */
+/* Everything needed to continue the run, written atomically (temporary file, fsync,
+ * rename).  meta: caller's text stored alongside (e.g. the workflow's stage), may be NULL. */
+int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *meta);
+/* Create a simulation from a checkpoint; *meta (may be NULL) receives a copy of the
+ * caller's text, to be released with mpmc_free. */
+int mpmc_sim_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);
+void mpmc_free(void *ptr);
+
+/* ---- user materials (material_user.c) ---------------------------------------------- */
+/* Called for each point of the material, from several threads at once: from the relative
+ * deformation gradient dF (3x3 row-major, F-bar scaled when on), update state[nstate]
+ * (initialised to zero) and the Cauchy stress[6] (Voigt, holds the previous stress on
+ * entry).  Returns 0, or non-zero to stop the step with MPMC_ERR_SOLVER. */
+typedef int (*mpmc_user_stress_fn)(void *data, const double *dF, double dt, double *state,
+                                   double *stress);
+int mpmc_sim_add_material_user(mpmc_sim sim, mpmc_user_stress_fn fn, void *data, int nstate,
+                               double rho, double wave_speed, int *id);
+int mpmc_sim_get_user_state(mpmc_sim sim, int material, double **state, int *nstate);
+
+/* ---- the staged workflow (workflows/, library libmpmc_workflow) ---------------------- */
+/* Run a YAML scene: the same as `mpmc run scene --out outdir --set ...`.  overrides are
+ * noverride "key.path=value" strings; flags: bit 0 = force (write over outdir).  The
+ * summary's figures are then in outdir/summary.json. */
+int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, int noverride,
+                      const char *const *overrides, int flags);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* MPMC_H */

@@ -1,0 +1,84 @@
+/* Grid to particle: velocity with the FLIP/PIC blend (eqs 11-13), relative deformation
+ * gradient dF = 1 + dt sum v_i (x) grad w (eq 16), J <- J det(dF) so that V = J V0 (eq 15),
+ * position (eq 17).  With F-bar the new positions go to xn: the projection still needs the
+ * weights at x^n. */
+#include <limits.h>
+#include <math.h>
+
+#include "transfer.h"
+
+MPMC_ALWAYS_INLINE void g2p_impl(mpmc_sim sim, const int DIM, const int BASIS, double dt,
+                                 int *bad) {
+  const mpmc_grid *g = &sim->grid;
+  mpmc_particles *p = &sim->p;
+  const double *restrict gv = g->mom, *restrict gdv = g->force;
+  const double eta = sim->flip;
+  double *restrict xout = sim->fbar ? p->xn : p->x;
+  const double *restrict lp = p->lp;
+  /* points may drift up to one cell beyond the box (walls act on the nodes there); further
+   * out, the support would leave the grid */
+  double xmin[3], xmax[3];
+  for (int a = 0; a < DIM; ++a) {
+    xmin[a] = g->lo[a] - g->h;
+    xmax[a] = g->hi[a] + g->h;
+  }
+  int first_bad = INT_MAX;
+#pragma omp parallel for schedule(static) reduction(min : first_bad)
+  for (int q = 0; q < p->n; ++q) {
+    const size_t qd = (size_t)q * DIM;
+    mpmc_pw pw;
+    mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? lp[q] : 0.0, &pw);
+    double vpic[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, L[3][3] = {{0}};
+    MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
+      for (int a = 0; a < DIM; ++a) {
+        const double va = gv[node * DIM + a];
+        vpic[a] += w * va;
+        dv[a] += w * gdv[node * DIM + a];
+        for (int b = 0; b < DIM; ++b) L[a][b] += va * gw[b];
+      }
+    });
+    double *dF = p->dF + (size_t)q * DIM * DIM;
+    for (int a = 0; a < DIM; ++a)
+      for (int b = 0; b < DIM; ++b) dF[a * DIM + b] = (a == b) + dt * L[a][b];
+    const double dJ = DIM == 2 ? dF[0] * dF[3] - dF[1] * dF[2]
+                               : dF[0] * (dF[4] * dF[8] - dF[5] * dF[7]) -
+                                     dF[1] * (dF[3] * dF[8] - dF[5] * dF[6]) +
+                                     dF[2] * (dF[3] * dF[7] - dF[4] * dF[6]);
+    p->J[q] *= dJ;
+    int ok = dJ > 0.0 && isfinite(dJ);
+    for (int a = 0; a < DIM; ++a) {
+      double *v = p->v + qd;
+      v[a] = eta * (v[a] + dv[a]) + (1.0 - eta) * vpic[a];
+      const double xa = p->x[qd + a] + dt * vpic[a];
+      xout[qd + a] = xa;
+      ok &= xa >= xmin[a] && xa <= xmax[a];
+    }
+    if (!ok && q < first_bad) first_bad = q;
+  }
+  *bad = first_bad == INT_MAX ? -1 : first_bad;
+}
+
+static int report(mpmc_sim sim, int q) {
+  const mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  const double *x = (sim->fbar ? p->xn : p->x) + (size_t)q * d;
+  const double *dF = p->dF + (size_t)q * d * d;
+  const double dJ = d == 2 ? dF[0] * dF[3] - dF[1] * dF[2] : NAN;
+  if (!(p->J[q] > 0.0) || !isfinite(p->J[q]))
+    return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
+                      "step %lld, t = %g: point %d at (%g, %g, %g) inverted or lost its volume "
+                      "(J = %g%s): reduce the time step",
+                      (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0,
+                      p->J[q], d == 2 && dJ <= 0 ? ", dJ <= 0" : "");
+  return MPMC_ERROR(sim->ctx, MPMC_ERR_OUTSIDE,
+                    "step %lld, t = %g: point %d left the grid box at (%g, %g, %g)",
+                    (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0);
+}
+
+/** Phase 3 of the step. */
+int mpmc_g2p(mpmc_sim sim, double dt) {
+  int bad = -1;
+  MPMC_DISPATCH(g2p_impl, sim, dt, &bad);
+  if (bad >= 0) return report(sim, bad);
+  return MPMC_SUCCESS;
+}

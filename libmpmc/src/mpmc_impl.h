@@ -1,0 +1,173 @@
+/* Private structures of libmpmc.  Not installed. */
+#ifndef MPMC_IMPL_H
+#define MPMC_IMPL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "mpmc.h"
+
+/* ---- context and errors (context.c, error.c) ---------------------------------- */
+#define MPMC_MSG_LEN 1024
+struct mpmc_context_s {
+  int last_code;
+  char last_msg[MPMC_MSG_LEN];
+  int log_level;
+};
+
+/* Record an error (file, line, formatted message) in ctx and return code. */
+int mpmc_error_set(mpmc_context ctx, int code, const char *file, int line, const char *fmt, ...)
+    __attribute__((format(printf, 5, 6)));
+void mpmc_log(mpmc_context ctx, int level, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+#define MPMC_ERROR(ctx, code, ...) mpmc_error_set((ctx), (code), __FILE__, __LINE__, __VA_ARGS__)
+/* Check cond; on failure record a message and return code from the calling function. */
+#define MPMC_CHECK(cond, ctx, code, ...)                                                \
+  do {                                                                                  \
+    if (!(cond)) return mpmc_error_set((ctx), (code), __FILE__, __LINE__, __VA_ARGS__); \
+  } while (0)
+/* Propagate a non-zero code. */
+#define MPMC_CALL(expr)          \
+  do {                           \
+    int mpmc_ierr_ = (expr);     \
+    if (mpmc_ierr_) return mpmc_ierr_; \
+  } while (0)
+
+/* ---- particles (particles.c): structure of arrays ------------------------------- */
+typedef struct {
+  int n, cap, dim;
+  double *x;     /* [n][dim] position                                             */
+  double *x0;    /* [n][dim] initial position                                     */
+  double *v;     /* [n][dim] velocity                                             */
+  double *m;     /* [n] mass                                                      */
+  double *vol0;  /* [n] initial volume                                            */
+  double *J;     /* [n] det F                                                     */
+  double *stress;/* [n][6] Cauchy stress, Voigt                                   */
+  int *mat;      /* [n] material id                                               */
+  /* allocated on demand (NULL when the scene does not need them) */
+  double *Jbar;  /* [n] det F-bar                (F-bar on)                          */
+  double *be;    /* [n][6] elastic left Cauchy-Green (solid materials)            */
+  double *eps_p; /* [n] equivalent plastic strain (plastic materials)             */
+  double *lp;    /* [n] uGIMP half-length, fixed at its initial value (uGIMP)      */
+  double *force; /* [n][dim] external force (tractions)                           */
+  /* step scratch */
+  double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
+  double *xn;    /* [n][dim] new positions while F-bar still needs the old ones    */
+} mpmc_particles;
+
+int mpmc_particles_reserve(mpmc_context ctx, mpmc_particles *p, int cap);
+int mpmc_particles_ensure(mpmc_context ctx, mpmc_particles *p, double **field, int ncomp,
+                          double fill);
+void mpmc_particles_free(mpmc_particles *p);
+
+/* ---- grid (grid.c) ------------------------------------------------------------------ */
+#define MPMC_GHOST 3 /* ghost cells outside the user box on each side (cubic needs 2) */
+typedef struct {
+  int dim;
+  double lo[3], hi[3]; /* user box                                                */
+  double h, inv_h;
+  double origin[3];    /* position of node 0 (lo - GHOST*h)                        */
+  int n[3];            /* nodes per axis (1 in unused axes)                         */
+  size_t nn;           /* total nodes                                              */
+  double *mass;        /* [nn]                                                     */
+  double *mom;         /* [nn][dim] momentum, then new velocity after grid update   */
+  double *force;       /* [nn][dim] f_int + f_ext, then velocity increment          */
+  double *vol;         /* [nn] F-bar: sum w V                                       */
+  double *jv;          /* [nn] F-bar: sum w V (Jbar dJ), then nodal Jbar            */
+  unsigned short *fixed; /* [nn] bit a: component a fixed; bit 3+a: v_a >= 0 only; bit 6+a: v_a <= 0 only */
+  int valid;
+} mpmc_grid;
+
+int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, const double *hi,
+                    double h);
+int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar);
+void mpmc_grid_clear(mpmc_grid *g, int with_fbar);
+void mpmc_grid_free(mpmc_grid *g);
+
+/* ---- materials (material.c, material_*.c) ------------------------------------------- */
+typedef enum {
+  MPMC_MAT_NEO_HOOKEAN = 0,
+  MPMC_MAT_HENCKY = 1,
+  MPMC_MAT_HENCKY_J2 = 2,
+  MPMC_MAT_NEWTONIAN = 3,
+  MPMC_MAT_USER = 4
+} mpmc_material_kind;
+
+struct mpmc_sim_s;
+typedef struct mpmc_material_s mpmc_material;
+
+/* The material table (STYLE.md): one file per model. */
+typedef struct {
+  const char *name;
+  /* Update the stress of every point p with mat[p] == id from the relative deformation
+   * gradient dF (F-bar scaled when F-bar is on).  Batched over the particle arrays. */
+  int (*stress_update)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt);
+  /* p-wave speed for the stable time step */
+  double (*wave_speed)(const mpmc_material *mat);
+} mpmc_material_ops;
+
+struct mpmc_material_s {
+  int kind;
+  const mpmc_material_ops *ops;
+  double rho;
+  double E, nu, K, G, lambda;               /* elastic constants                     */
+  double kappa_p, kappa_r, eta;             /* J2 softening                          */
+  double mu;                                /* fluid viscosity                       */
+  int solid;                                /* needs be                              */
+  int plastic;                              /* needs eps_p                           */
+};
+
+extern const mpmc_material_ops mpmc_ops_neo_hookean;
+extern const mpmc_material_ops mpmc_ops_hencky;
+extern const mpmc_material_ops mpmc_ops_hencky_j2;
+extern const mpmc_material_ops mpmc_ops_newtonian;
+
+/* ---- walls (boundary.c) ------------------------------------------------------------ */
+typedef struct {
+  int active;
+  int kind, axis, side;
+  double lo[3], hi[3]; /* the constrained region (infinite in unbounded directions) */
+} mpmc_wall;
+
+/* ---- the simulation ---------------------------------------------------------------- */
+struct mpmc_sim_s {
+  mpmc_context ctx;
+  int dim;
+  int basis;
+  int fbar;
+  double flip;        /* FLIP/PIC blend eta (eq 13)                                    */
+  double gravity[3];
+  double damping;     /* local damping alpha                                           */
+  int solver;
+  int nthreads;
+  int force_dt;
+  mpmc_grid grid;
+  mpmc_particles p;
+  mpmc_material *mats;
+  int nmat, capmat;
+  mpmc_wall *walls;
+  int nwall, capwall;
+  int walls_dirty;    /* recompute the node constraint flags                           */
+  int prepared;       /* fields and grid arrays match the configuration               */
+  double time;
+  mpmc_stats stats;
+  void *solver_ws;    /* return-mapping workspaces (return_map.c), per thread          */
+};
+
+/* phases of one step (step.c calls them in this order) */
+int mpmc_p2g(struct mpmc_sim_s *sim, double dt);
+int mpmc_grid_update(struct mpmc_sim_s *sim, double dt);
+int mpmc_g2p(struct mpmc_sim_s *sim, double dt);
+int mpmc_fbar(struct mpmc_sim_s *sim);
+int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
+
+/* helpers shared between files */
+int mpmc_sim_prepare(struct mpmc_sim_s *sim);
+int mpmc_boundary_apply_flags(struct mpmc_sim_s *sim);
+void mpmc_damping_apply(double alpha, double *restrict f, const double *restrict v, int dim);
+double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor);
+void mpmc_return_map_free(struct mpmc_sim_s *sim);
+int mpmc_material_validate_elastic(mpmc_context ctx, double E, double nu, double rho);
+
+#endif

@@ -1,0 +1,385 @@
+/* The simulation handle: set-up, material points, field access. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "mpmc_impl.h"
+
+/**
+ * @brief Create a simulation in dim = 2 (plane strain) or 3 dimensions.
+ * Defaults: quadratic B-splines, F-bar off, FLIP/PIC blend 1 (pure FLIP, paper eq 13),
+ * no gravity, no damping, solver auto.
+ */
+int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
+  if (!ctx || !sim) return ctx ? MPMC_ERROR(ctx, MPMC_ERR_ARG, "sim pointer is NULL") : MPMC_ERR_ARG;
+  MPMC_CHECK(dim == 2 || dim == 3, ctx, MPMC_ERR_ARG, "dimension dim = %d must be 2 or 3", dim);
+  mpmc_sim s = calloc(1, sizeof *s);
+  MPMC_CHECK(s, ctx, MPMC_ERR_MEMORY, "cannot allocate a simulation");
+  s->ctx = ctx;
+  s->dim = dim;
+  s->basis = MPMC_BASIS_BSPLINE2;
+  s->flip = 1.0;
+  s->solver = MPMC_SOLVER_AUTO;
+  s->p.dim = dim;
+  *sim = s;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Destroy a simulation; accepts NULL and sets the handle to NULL. */
+int mpmc_sim_destroy(mpmc_sim *sim) {
+  if (!sim || !*sim) return MPMC_SUCCESS;
+  mpmc_sim s = *sim;
+  mpmc_return_map_free(s);
+  mpmc_particles_free(&s->p);
+  mpmc_grid_free(&s->grid);
+  free(s->mats);
+  free(s->walls);
+  free(s);
+  *sim = NULL;
+  return MPMC_SUCCESS;
+}
+
+int mpmc_sim_get_context(const mpmc_sim sim, mpmc_context *ctx) {
+  if (!sim || !ctx) return MPMC_ERR_ARG;
+  *ctx = sim->ctx;
+  return MPMC_SUCCESS;
+}
+
+int mpmc_sim_get_dim(const mpmc_sim sim, int *dim) {
+  if (!sim || !dim) return MPMC_ERR_ARG;
+  *dim = sim->dim;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Set the background grid: the box [lo, hi] (dim values each) with cell size h.
+ * Must come before particles are added.
+ */
+int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(lo && hi, sim->ctx, MPMC_ERR_ARG, "grid lo/hi arrays are NULL");
+  MPMC_CHECK(sim->p.n == 0, sim->ctx, MPMC_ERR_STATE,
+             "the grid must be set before material points are added");
+  MPMC_CALL(mpmc_grid_setup(sim->ctx, &sim->grid, sim->dim, lo, hi, h));
+  sim->prepared = 0;
+  sim->walls_dirty = 1;
+  return MPMC_SUCCESS;
+}
+
+/** @brief The grid box and cell size (as rounded to whole cells). */
+int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(sim->grid.valid, sim->ctx, MPMC_ERR_STATE, "no grid set");
+  for (int a = 0; a < sim->dim; ++a) {
+    if (lo) lo[a] = sim->grid.lo[a];
+    if (hi) hi[a] = sim->grid.hi[a];
+  }
+  if (h) *h = sim->grid.h;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Choose the basis (mpmc_basis). uGIMP needs each point's volume at its addition. */
+int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(basis >= MPMC_BASIS_LINEAR && basis <= MPMC_BASIS_BSPLINE3, sim->ctx, MPMC_ERR_ARG,
+             "basis = %d is not one of linear (0), ugimp (1), bspline2 (2), bspline3 (3)", basis);
+  sim->basis = basis;
+  sim->prepared = 0;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Switch the F-bar projection (paper Algorithm 1) on (1) or off (0). */
+int mpmc_sim_set_fbar(mpmc_sim sim, int enabled) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(enabled == 0 || enabled == 1, sim->ctx, MPMC_ERR_ARG, "fbar = %d must be 0 or 1",
+             enabled);
+  sim->fbar = enabled;
+  sim->prepared = 0;
+  return MPMC_SUCCESS;
+}
+
+int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled) {
+  if (!sim || !enabled) return MPMC_ERR_ARG;
+  *enabled = sim->fbar;
+  return MPMC_SUCCESS;
+}
+
+/** @brief FLIP/PIC blend eta in [0, 1] (eq 13): 1 pure FLIP, 0 pure PIC. */
+int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(isfinite(eta) && eta >= 0 && eta <= 1, sim->ctx, MPMC_ERR_ARG,
+             "FLIP/PIC blend = %g must be in [0, 1]", eta);
+  sim->flip = eta;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Gravitational acceleration g[dim] [m/s^2]. */
+int mpmc_sim_set_gravity(mpmc_sim sim, const double *g) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(g, sim->ctx, MPMC_ERR_ARG, "gravity array is NULL");
+  for (int a = 0; a < sim->dim; ++a)
+    MPMC_CHECK(isfinite(g[a]), sim->ctx, MPMC_ERR_ARG, "gravity component %d = %g is not finite", a,
+               g[a]);
+  for (int a = 0; a < 3; ++a) sim->gravity[a] = a < sim->dim ? g[a] : 0.0;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Local (Cundall / Al-Kafaji) damping factor alpha in [0, 1); 0 switches it off. */
+int mpmc_sim_set_damping(mpmc_sim sim, double alpha) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(isfinite(alpha) && alpha >= 0 && alpha < 1, sim->ctx, MPMC_ERR_ARG,
+             "local damping alpha = %g must be in [0, 1)", alpha);
+  sim->damping = alpha;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Local solver for plastic return mapping (mpmc_solver). */
+int mpmc_sim_set_solver(mpmc_sim sim, int solver) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(solver >= MPMC_SOLVER_AUTO && solver <= MPMC_SOLVER_KINSOL, sim->ctx, MPMC_ERR_ARG,
+             "solver = %d is not one of auto (0), newton (1), kinsol (2)", solver);
+  sim->solver = solver;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Threads used by the step (0: OpenMP's default). */
+int mpmc_sim_set_threads(mpmc_sim sim, int nthreads) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(nthreads >= 0 && nthreads <= 1024, sim->ctx, MPMC_ERR_ARG,
+             "threads = %d must be in [0, 1024]", nthreads);
+  sim->nthreads = nthreads;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Allow steps above the stability limit (1) or refuse them (0, the default). */
+int mpmc_sim_set_force_dt(mpmc_sim sim, int force) {
+  if (!sim) return MPMC_ERR_ARG;
+  sim->force_dt = force != 0;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Add n material points of one material.
+ * @param x positions [n*dim], inside the grid box
+ * @param volume initial volumes [n] (> 0; per unit thickness in 2D)
+ * @param material id from an mpmc_sim_add_material_* call
+ * @param[out] first index of the first new point (may be NULL)
+ */
+int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *volume, int material,
+                           int *first) {
+  if (!sim) return MPMC_ERR_ARG;
+  mpmc_context ctx = sim->ctx;
+  mpmc_particles *p = &sim->p;
+  const mpmc_grid *g = &sim->grid;
+  const int d = sim->dim;
+  MPMC_CHECK(g->valid, ctx, MPMC_ERR_STATE, "set the grid before adding material points");
+  MPMC_CHECK(n >= 0, ctx, MPMC_ERR_ARG, "number of points n = %d must be >= 0", n);
+  MPMC_CHECK(n == 0 || (x && volume), ctx, MPMC_ERR_ARG, "position or volume array is NULL");
+  MPMC_CHECK(material >= 0 && material < sim->nmat, ctx, MPMC_ERR_ARG,
+             "material id %d does not exist (%d materials)", material, sim->nmat);
+  MPMC_CHECK(n <= INT32_MAX - p->n, ctx, MPMC_ERR_ARG, "too many material points");
+  for (int i = 0; i < n; ++i) {
+    for (int a = 0; a < d; ++a) {
+      const double xa = x[(size_t)i * d + a];
+      MPMC_CHECK(isfinite(xa) && xa >= g->lo[a] && xa <= g->hi[a], ctx, MPMC_ERR_OUTSIDE,
+                 "point %d: coordinate %d = %g outside the grid box [%g, %g]", i, a, xa, g->lo[a],
+                 g->hi[a]);
+    }
+    MPMC_CHECK(isfinite(volume[i]) && volume[i] > 0, ctx, MPMC_ERR_ARG,
+               "point %d: volume = %g must be > 0", i, volume[i]);
+    if (sim->basis == MPMC_BASIS_UGIMP) {
+      const double lp = 0.5 * pow(volume[i], 1.0 / d);
+      MPMC_CHECK(lp <= 0.5 * g->h * (1 + 1e-9), ctx, MPMC_ERR_ARG,
+                 "point %d: uGIMP half-length %g exceeds half a cell (%g): use at least one point per cell",
+                 i, lp, 0.5 * g->h);
+    }
+  }
+  int cap = p->cap ? p->cap : 64;
+  while (cap < p->n + n) cap = cap > INT32_MAX / 2 ? INT32_MAX : 2 * cap;
+  MPMC_CALL(mpmc_particles_reserve(ctx, p, cap));
+  const mpmc_material *m = &sim->mats[material];
+  const int n0 = p->n;
+  for (int i = 0; i < n; ++i) {
+    const size_t q = (size_t)(n0 + i);
+    for (int a = 0; a < d; ++a) {
+      p->x[q * d + a] = x[(size_t)i * d + a];
+      p->x0[q * d + a] = x[(size_t)i * d + a];
+      p->v[q * d + a] = 0.0;
+    }
+    p->vol0[q] = volume[i];
+    p->m[q] = m->rho * volume[i];
+    p->J[q] = 1.0;
+    for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
+    p->mat[q] = material;
+    if (p->Jbar) p->Jbar[q] = 1.0;
+    if (p->be)
+      for (int k = 0; k < 6; ++k) p->be[q * 6 + k] = k < 3 ? 1.0 : 0.0;
+    if (p->eps_p) p->eps_p[q] = 0.0;
+    if (p->lp) p->lp[q] = 0.5 * pow(volume[i], 1.0 / d);
+    if (p->force)
+      for (int a = 0; a < d; ++a) p->force[q * d + a] = 0.0;
+  }
+  p->n = n0 + n;
+  if (first) *first = n0;
+  sim->prepared = 0;
+  return MPMC_SUCCESS;
+}
+
+int mpmc_sim_get_num_particles(const mpmc_sim sim, int *n) {
+  if (!sim || !n) return MPMC_ERR_ARG;
+  *n = sim->p.n;
+  return MPMC_SUCCESS;
+}
+
+/* Allocate the optional fields and grid arrays the configuration needs. */
+int mpmc_sim_prepare(mpmc_sim sim) {
+  if (sim->prepared) return MPMC_SUCCESS;
+  mpmc_context ctx = sim->ctx;
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "no grid set");
+  int solid = 0, plastic = 0;
+  for (int i = 0; i < sim->nmat; ++i) {
+    solid |= sim->mats[i].solid;
+    plastic |= sim->mats[i].plastic;
+  }
+  if (p->cap == 0) MPMC_CALL(mpmc_particles_reserve(ctx, p, 64));
+  if (solid) {
+    if (!p->be) {
+      MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->be, 6, 0.0));
+      for (int q = 0; q < p->n; ++q)
+        for (int k = 0; k < 3; ++k) p->be[(size_t)q * 6 + k] = 1.0;
+    }
+  }
+  if (plastic) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->eps_p, 1, 0.0));
+  if (sim->fbar && !p->Jbar) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
+    for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
+  }
+  if (sim->fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->xn, d, 0.0));
+  if (sim->basis == MPMC_BASIS_UGIMP && !p->lp) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->lp, 1, 0.0));
+    for (int q = 0; q < p->n; ++q) {
+      p->lp[q] = 0.5 * pow(p->vol0[q], 1.0 / d);
+      MPMC_CHECK(p->lp[q] <= 0.5 * sim->grid.h * (1 + 1e-9), ctx, MPMC_ERR_ARG,
+                 "point %d: uGIMP half-length %g exceeds half a cell (%g)", q, p->lp[q],
+                 0.5 * sim->grid.h);
+    }
+  }
+  MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->dF, d * d, 0.0));
+  MPMC_CALL(mpmc_grid_alloc(ctx, &sim->grid, sim->fbar));
+  sim->walls_dirty = 1;
+  sim->prepared = 1;
+  return MPMC_SUCCESS;
+}
+
+static double **field_ptr(mpmc_sim sim, int field, int *ncomp) {
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  switch (field) {
+    case MPMC_FIELD_POSITION: *ncomp = d; return &p->x;
+    case MPMC_FIELD_VELOCITY: *ncomp = d; return &p->v;
+    case MPMC_FIELD_MASS: *ncomp = 1; return &p->m;
+    case MPMC_FIELD_VOLUME0: *ncomp = 1; return &p->vol0;
+    case MPMC_FIELD_J: *ncomp = 1; return &p->J;
+    case MPMC_FIELD_JBAR: *ncomp = 1; return &p->Jbar;
+    case MPMC_FIELD_STRESS: *ncomp = 6; return &p->stress;
+    case MPMC_FIELD_BE: *ncomp = 6; return &p->be;
+    case MPMC_FIELD_EPS_P: *ncomp = 1; return &p->eps_p;
+    case MPMC_FIELD_FORCE: *ncomp = d; return &p->force;
+    case MPMC_FIELD_X0: *ncomp = d; return &p->x0;
+    default: return NULL;
+  }
+}
+
+static const char *field_names[MPMC_FIELD_COUNT] = {
+    "position", "velocity", "mass", "volume0", "J", "Jbar", "stress", "be", "eps_p", "force", "x0"};
+
+/**
+ * @brief Borrow a particle field in place (no copy).  Layout [n][ncomp].
+ * Optional fields are created by the first step (or mpmc_sim_get_field after it):
+ * a field the scene does not have is MPMC_ERR_STATE.
+ */
+int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(data, sim->ctx, MPMC_ERR_ARG, "data pointer is NULL");
+  int nc = 0;
+  double **f = field_ptr(sim, field, &nc);
+  MPMC_CHECK(f, sim->ctx, MPMC_ERR_ARG, "field = %d is not a particle field", field);
+  if (!*f && sim->grid.valid) MPMC_CALL(mpmc_sim_prepare(sim));
+  MPMC_CHECK(*f, sim->ctx, MPMC_ERR_STATE, "this simulation has no '%s' field", field_names[field]);
+  *data = *f;
+  if (ncomp) *ncomp = nc;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Give back a field borrowed with mpmc_sim_get_field; sets *data to NULL. */
+int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(field >= 0 && field < MPMC_FIELD_COUNT, sim->ctx, MPMC_ERR_ARG,
+             "field = %d is not a particle field", field);
+  if (data) *data = NULL;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Borrow the material id of each point (read-only). */
+int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids) {
+  if (!sim || !ids) return MPMC_ERR_ARG;
+  *ids = sim->p.mat;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Set the external force f[n*dim] on points [first, first+n). */
+int mpmc_sim_set_particle_forces(mpmc_sim sim, int first, int n, const double *f) {
+  if (!sim) return MPMC_ERR_ARG;
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  MPMC_CHECK(first >= 0 && n >= 0 && first <= p->n - n, sim->ctx, MPMC_ERR_ARG,
+             "points [%d, %d) outside [0, %d)", first, first + n, p->n);
+  MPMC_CHECK(n == 0 || f, sim->ctx, MPMC_ERR_ARG, "force array is NULL");
+  for (int i = 0; i < n * d; ++i)
+    MPMC_CHECK(isfinite(f[i]), sim->ctx, MPMC_ERR_ARG, "force component %d = %g is not finite", i,
+               f[i]);
+  MPMC_CALL(mpmc_particles_ensure(sim->ctx, p, &p->force, d, 0.0));
+  memcpy(p->force + (size_t)first * d, f, sizeof(double) * (size_t)n * d);
+  return MPMC_SUCCESS;
+}
+
+int mpmc_sim_get_time(const mpmc_sim sim, double *t) {
+  if (!sim || !t) return MPMC_ERR_ARG;
+  *t = sim->time;
+  return MPMC_SUCCESS;
+}
+
+int mpmc_sim_set_time(mpmc_sim sim, double t) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(isfinite(t), sim->ctx, MPMC_ERR_ARG, "time = %g is not finite", t);
+  sim->time = t;
+  return MPMC_SUCCESS;
+}
+
+/** @brief Total kinetic energy 1/2 sum m |v|^2 of the material points. */
+int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke) {
+  if (!sim || !ke) return MPMC_ERR_ARG;
+  const mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  double e = 0.0;
+#pragma omp parallel for reduction(+ : e) schedule(static)
+  for (int q = 0; q < p->n; ++q) {
+    double v2 = 0.0;
+    for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];
+    e += 0.5 * p->m[q] * v2;
+  }
+  *ke = e;
+  return MPMC_SUCCESS;
+}
+
+int mpmc_sim_get_stats(const mpmc_sim sim, mpmc_stats *stats) {
+  if (!sim || !stats) return MPMC_ERR_ARG;
+  *stats = sim->stats;
+  stats->time = sim->time;
+  return MPMC_SUCCESS;
+}

@@ -1,0 +1,30 @@
+/* Stress update: each material updates its points from dF (dF-bar with F-bar on), batched
+ * over the particle arrays; then the step's guard against NaN/Inf stress. */
+#include <limits.h>
+#include <math.h>
+
+#include "mpmc_impl.h"
+
+/** Phase 5 of the step. */
+int mpmc_stress_update(mpmc_sim sim, double dt) {
+  for (int m = 0; m < sim->nmat; ++m)
+    MPMC_CALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, dt));
+  const mpmc_particles *p = &sim->p;
+  int first_bad = INT_MAX;
+#pragma omp parallel for schedule(static) reduction(min : first_bad)
+  for (int q = 0; q < p->n; ++q) {
+    const double *s = p->stress + (size_t)q * 6;
+    const double sum = s[0] + s[1] + s[2] + s[3] + s[4] + s[5];
+    if (!isfinite(sum) && q < first_bad) first_bad = q;
+  }
+  if (first_bad != INT_MAX) {
+    const int q = first_bad, d = sim->dim;
+    const double *x = p->x + (size_t)q * d;
+    return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
+                      "step %lld, t = %g: point %d at (%g, %g, %g) (material %d) has a non-finite "
+                      "stress after the stress update",
+                      (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0,
+                      p->mat[q]);
+  }
+  return MPMC_SUCCESS;
+}
