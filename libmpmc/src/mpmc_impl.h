@@ -51,6 +51,9 @@ typedef struct {
   double *eps_p; /* [n] equivalent plastic strain (plastic materials)             */
   double *lp;    /* [n] uGIMP half-length, fixed at its initial value (uGIMP)      */
   double *force; /* [n][dim] external force (tractions)                           */
+  double *cforce;/* [n][dim] contact force from rigid bodies (contact_barrier.c)   */
+  double *ustate;/* [n][nustate] state of user materials (material_user.c)        */
+  int nustate;
   /* step scratch */
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
   double *xn;    /* [n][dim] new positions while F-bar still needs the old ones    */
@@ -153,6 +156,8 @@ struct mpmc_sim_s {
   double time;
   mpmc_stats stats;
   void *solver_ws;    /* return-mapping workspaces (return_map.c), per thread          */
+  struct mpmc_bodies_s *bodies; /* rigid bodies and barrier contact (contact_barrier.c) */
+  struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
 };
 
 /* phases of one step (step.c calls them in this order) */
@@ -168,6 +173,13 @@ int mpmc_boundary_apply_flags(struct mpmc_sim_s *sim);
 void mpmc_damping_apply(double alpha, double *restrict f, const double *restrict v, int dim);
 double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor);
 void mpmc_return_map_free(struct mpmc_sim_s *sim);
+/* contact_barrier.c: fill p->cforce before P2G (only called when sim->bodies is set), the
+ * time-step limit of the barrier stiffness (INFINITY without bodies), and clean-up */
+int mpmc_contact_update(struct mpmc_sim_s *sim, double dt);
+double mpmc_contact_stable_dt(const struct mpmc_sim_s *sim);
+void mpmc_contact_free(struct mpmc_sim_s *sim);
+/* sets.c */
+void mpmc_sets_free(struct mpmc_sim_s *sim);
 int mpmc_material_validate_elastic(mpmc_context ctx, double E, double nu, double rho);
 
 #endif

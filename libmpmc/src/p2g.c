@@ -9,6 +9,7 @@ MPMC_ALWAYS_INLINE void p2g_impl(mpmc_sim sim, const int DIM, const int BASIS, i
   double *restrict gm = g->mass, *restrict gp = g->mom, *restrict gf = g->force;
   const double *restrict lp = p->lp;
   const double *restrict pf = p->force;
+  const double *restrict pc = p->cforce;
   for (int q = 0; q < p->n; ++q) {
     const size_t qd = (size_t)q * DIM;
     mpmc_pw pw;
@@ -26,6 +27,8 @@ MPMC_ALWAYS_INLINE void p2g_impl(mpmc_sim sim, const int DIM, const int BASIS, i
     double fe[3] = {0, 0, 0};
     if (pf)
       for (int a = 0; a < DIM; ++a) fe[a] = pf[qd + a];
+    if (pc)
+      for (int a = 0; a < DIM; ++a) fe[a] += pc[qd + a];
     MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
       gm[node] += w * m;
       for (int a = 0; a < DIM; ++a) {

@@ -38,6 +38,8 @@ int mpmc_particles_reserve(mpmc_context ctx, mpmc_particles *p, int cap) {
   MPMC_CALL(grow(ctx, &p->eps_p, 1, cap));
   MPMC_CALL(grow(ctx, &p->lp, 1, cap));
   MPMC_CALL(grow(ctx, &p->force, d, cap));
+  MPMC_CALL(grow(ctx, &p->cforce, d, cap));
+  if (p->nustate > 0) MPMC_CALL(grow(ctx, &p->ustate, (size_t)p->nustate, cap));
   MPMC_CALL(grow(ctx, &p->dF, (size_t)d * d, cap));
   MPMC_CALL(grow(ctx, &p->xn, d, cap));
   p->cap = cap;
@@ -57,12 +59,12 @@ int mpmc_particles_ensure(mpmc_context ctx, mpmc_particles *p, double **field, i
 
 void mpmc_particles_free(mpmc_particles *p) {
   double **f[] = {&p->x, &p->x0, &p->v, &p->m, &p->vol0, &p->J, &p->stress, &p->Jbar,
-                  &p->be, &p->eps_p, &p->lp, &p->force, &p->dF, &p->xn};
+                  &p->be, &p->eps_p, &p->lp, &p->force, &p->cforce, &p->ustate, &p->dF, &p->xn};
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
     free(*f[i]);
     *f[i] = NULL;
   }
   free(p->mat);
   p->mat = NULL;
-  p->n = p->cap = 0;
+  p->n = p->cap = p->nustate = 0;
 }

@@ -33,6 +33,8 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   if (!sim || !*sim) return MPMC_SUCCESS;
   mpmc_sim s = *sim;
   mpmc_return_map_free(s);
+  mpmc_contact_free(s);
+  mpmc_sets_free(s);
   mpmc_particles_free(&s->p);
   mpmc_grid_free(&s->grid);
   free(s->mats);
@@ -221,6 +223,9 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
     if (p->lp) p->lp[q] = 0.5 * pow(volume[i], 1.0 / d);
     if (p->force)
       for (int a = 0; a < d; ++a) p->force[q * d + a] = 0.0;
+    if (p->cforce)
+      for (int a = 0; a < d; ++a) p->cforce[q * d + a] = 0.0;
+    for (int k = 0; k < p->nustate; ++k) p->ustate[q * (size_t)p->nustate + k] = 0.0;
   }
   p->n = n0 + n;
   if (first) *first = n0;

@@ -26,6 +26,10 @@ double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
   vmax = sqrt(vmax);
   double dt = cmax + vmax > 0 ? sim->grid.h / (cmax + vmax) : INFINITY;
   if (visc < dt) dt = visc;
+  if (sim->bodies) {
+    const double tc = mpmc_contact_stable_dt(sim);
+    if (tc < dt) dt = tc;
+  }
   return factor * dt;
 }
 

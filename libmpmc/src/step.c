@@ -14,6 +14,7 @@ static double now(void) {
 }
 
 static int step_phases(mpmc_sim sim, double dt) {
+  if (sim->bodies) MPMC_CALL(mpmc_contact_update(sim, dt)); /* barrier forces on points */
   MPMC_CALL(mpmc_p2g(sim, dt));          /* mass, momentum, forces      (eqs 7, 8, 10) */
   MPMC_CALL(mpmc_grid_update(sim, dt));  /* velocities, walls, damping  (eq 9)         */
   MPMC_CALL(mpmc_g2p(sim, dt));          /* v, dF, J, x                 (eqs 13-17)    */
