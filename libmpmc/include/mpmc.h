@@ -62,6 +62,14 @@ typedef enum {
   MPMC_WALL_SEPARABLE = 2 /* normal component may only point away from the wall  */
 } mpmc_wall_kind;
 
+/* The F-bar projection (mpmc_sim_set_fbar). */
+typedef enum {
+  MPMC_FBAR_OFF = 0,   /* the standard formulation                                     */
+  MPMC_FBAR_PAPER = 1, /* Algorithm 1 as published: projects Jbar^n dJ (eq 26)         */
+  MPMC_FBAR_TOTAL = 2  /* projects the Jacobian det F (eqs 18-21 in eq 25): no drift in  */
+                       /* long quasi-static runs (docs/theory.md)                       */
+} mpmc_fbar_mode;
+
 typedef enum {
   MPMC_SOLVER_AUTO = 0,   /* scalar Newton, KINSOL where Newton is unsafe        */
   MPMC_SOLVER_NEWTON = 1, /* safeguarded scalar Newton only                      */
@@ -115,7 +123,7 @@ int mpmc_sim_get_dim(const mpmc_sim sim, int *dim);
 int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h);
 int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h);
 int mpmc_sim_set_basis(mpmc_sim sim, int basis);
-int mpmc_sim_set_fbar(mpmc_sim sim, int enabled);
+int mpmc_sim_set_fbar(mpmc_sim sim, int mode); /* mpmc_fbar_mode; 1 = on (paper) */
 int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled);
 int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
@@ -130,6 +138,12 @@ int mpmc_sim_add_material_hencky(mpmc_sim sim, double E, double nu, double rho, 
  * q = sqrt(3/2)|dev tau| <= kappa(eps_p) = kappa_r + (kappa_p - kappa_r) exp(-eta eps_p). */
 int mpmc_sim_add_material_hencky_j2(mpmc_sim sim, double E, double nu, double rho,
                                     double kappa_p, double kappa_r, double eta, int *id);
+/* The same with undrained shear strengths: kappa = sqrt(3) su (von Mises shear strength,
+ * as in plane-strain shear; docs/materials.md). */
+int mpmc_sim_add_material_hencky_j2_su(mpmc_sim sim, double E, double nu, double rho,
+                                       double su_p, double su_r, double eta, int *id);
+/* The paper's strength reduction factor (landslide trigger), for mpmc_sim_reduce_strength. */
+#define MPMC_DEFAULT_STRENGTH_REDUCTION 1.65
 /* Nearly incompressible Newtonian fluid: p = -K (J - 1), deviatoric 2 mu dev(D). */
 int mpmc_sim_add_material_newtonian(mpmc_sim sim, double K, double mu, double rho, int *id);
 int mpmc_sim_get_num_materials(const mpmc_sim sim, int *n);
@@ -178,6 +192,29 @@ int mpmc_sim_set_time(mpmc_sim sim, double t);
 int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke);
 int mpmc_sim_get_stats(const mpmc_sim sim, mpmc_stats *stats);
 
+/* ---- rigid bodies and contact (contact_barrier.c) ------------------------------------ */
+/* Rigid bodies (axis-aligned boxes in 2D/3D, simple polygons in 2D) move with a prescribed
+ * velocity and push the material points through the IPC barrier on the gap d between a
+ * point and the body's surface:  f = A_p kappa (d - dhat)[2 ln(d/dhat) + 1 - dhat/d] n for
+ * 0 < d < dhat (A_p = V0^((dim-1)/dim), n the body's outward normal), with Coulomb friction
+ * mu smoothed near zero slip.  The explicit time step accounts for the barrier stiffness
+ * (mpmc_sim_stable_dt); a step after which a point lies inside a body fails with
+ * MPMC_ERR_NUMERIC.  Defaults of dhat and kappa: docs/contact.md. */
+int mpmc_sim_add_rigid_box(mpmc_sim sim, const double *lo, const double *hi, double mu, int *id);
+/* 2D only: nvert vertices xy[2*nvert], either orientation. */
+int mpmc_sim_add_rigid_polygon(mpmc_sim sim, int nvert, const double *xy, double mu, int *id);
+int mpmc_sim_remove_rigid(mpmc_sim sim, int id);
+int mpmc_sim_set_rigid_velocity(mpmc_sim sim, int id, const double *v);
+/* Displacement of the body since it was added. */
+int mpmc_sim_get_rigid_offset(const mpmc_sim sim, int id, double *offset);
+/* Force of the points on the body in the last step (per unit thickness in 2D). */
+int mpmc_sim_get_rigid_reaction(const mpmc_sim sim, int id, double *f);
+/* Smallest signed distance of any point to the body (negative inside) and that point. */
+int mpmc_sim_get_rigid_gap(const mpmc_sim sim, int id, double *gap, int *point);
+/* Barrier range dhat [m] and stiffness kappa [Pa/m] for all bodies; 0 = derived default. */
+int mpmc_sim_set_contact_params(mpmc_sim sim, double dhat, double kappa);
+int mpmc_sim_get_contact_params(const mpmc_sim sim, double *dhat, double *kappa);
+
 /* ---- named particle sets (sets.c) ---------------------------------------------- */
 /* Sets name groups of points (gmsh boundary groups, traction edges, tracked points).
  * Adding a set with an existing name replaces it.  Indices are copied. */
@@ -224,6 +261,12 @@ int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *
  * caller's text, to be released with mpmc_free. */
 int mpmc_sim_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);
 void mpmc_free(void *ptr);
+/* A checkpoint cannot hold a function pointer: after mpmc_sim_checkpoint_read, re-attach the
+ * stress function of each user material (its steps fail with MPMC_ERR_STATE until then). */
+int mpmc_sim_set_material_user_fn(mpmc_sim sim, int material,
+                                  int (*fn)(void *data, const double *dF, double dt, double *state,
+                                            double *stress),
+                                  void *data);
 
 /* ---- user materials (material_user.c) ---------------------------------------------- */
 /* Called for each point of the material, from several threads at once: from the relative
@@ -232,8 +275,14 @@ void mpmc_free(void *ptr);
  * entry).  Returns 0, or non-zero to stop the step with MPMC_ERR_SOLVER. */
 typedef int (*mpmc_user_stress_fn)(void *data, const double *dF, double dt, double *state,
                                    double *stress);
+/* nstate in [0, 4096]; wave_speed: the material's p-wave speed [m/s] for the stable step.
+ * In plane strain dF is the 3x3 embedding (dF[8] = 1).  From Fortran: a bind(C) function
+ * registered with c_funloc (module mpmc, fortran/mpmc.f90). */
 int mpmc_sim_add_material_user(mpmc_sim sim, mpmc_user_stress_fn fn, void *data, int nstate,
                                double rho, double wave_speed, int *id);
+/* Borrow the user state of every point, [n][*nstate]: *nstate is the row length (that of the
+ * user material with the most state); the points of `material` use the first entries of
+ * their rows.  Valid until points are added. */
 int mpmc_sim_get_user_state(mpmc_sim sim, int material, double **state, int *nstate);
 
 /* ---- the staged workflow (workflows/, library libmpmc_workflow) ---------------------- */
@@ -242,6 +291,11 @@ int mpmc_sim_get_user_state(mpmc_sim sim, int material, double **state, int *nst
  * summary's figures are then in outdir/summary.json. */
 int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, int noverride,
                       const char *const *overrides, int flags);
+#define MPMC_WORKFLOW_FORCE 1 /* write into an existing, non-empty outdir              */
+#define MPMC_WORKFLOW_QUIET 2 /* no log and no progress display                        */
+#define MPMC_WORKFLOW_CHECK 4 /* validate the scene and print the plan; run nothing     */
+/* Continue the run in outdir from its last checkpoint (`mpmc resume`); flags: QUIET. */
+int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags);
 
 #ifdef __cplusplus
 }

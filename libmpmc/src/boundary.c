@@ -105,6 +105,13 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
   if (!g->fixed) return MPMC_SUCCESS;
   const double tol = 1e-9 * g->h;
   for (size_t i = 0; i < g->nn; ++i) g->fixed[i] = 0;
+  free(sim->mirrors);
+  sim->mirrors = NULL;
+  sim->nmirror = 0;
+  if (sim->nwall > 0) {
+    sim->mirrors = malloc(sizeof *sim->mirrors * (size_t)sim->nwall);
+    MPMC_CHECK(sim->mirrors, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate wall mirrors");
+  }
   for (int wi = 0; wi < sim->nwall; ++wi) {
     const mpmc_wall *w = &sim->walls[wi];
     if (!w->active) continue;
@@ -127,6 +134,19 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i)
           g->fixed[(size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * (size_t)k)] |= bits;
+    /* a fixed or slip half-space wall on a node plane mirrors its ghost nodes */
+    int unbounded = 1;
+    for (int a = 0; a < sim->dim; ++a)
+      if (a != w->axis) unbounded &= isinf(w->lo[a]) && isinf(w->hi[a]);
+    const double plane = (w->side < 0 ? w->hi[w->axis] : w->lo[w->axis]);
+    const double s = (plane - g->origin[w->axis]) * g->inv_h;
+    if (unbounded && w->kind != MPMC_WALL_SEPARABLE && fabs(s - round(s)) < 1e-9) {
+      mpmc_mirror *m = &sim->mirrors[sim->nmirror++];
+      m->axis = w->axis;
+      m->side = w->side;
+      m->plane = (int)round(s);
+      m->odd = w->kind == MPMC_WALL_FIXED ? 7u : 1u << w->axis;
+    }
   }
   sim->walls_dirty = 0;
   return MPMC_SUCCESS;

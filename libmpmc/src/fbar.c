@@ -1,6 +1,11 @@
 /* The F-bar projection (paper Algorithm 1, eqs 19-27), run only when enabled:
- *   scatter  V_i = sum w V_p,  (V J)_i = sum w V_p (Jbar_p^n dJ_p)           (step 3)
+ *   scatter  V_i = sum w V_p,  (V J)_i = sum w V_p j_p                          (step 3)
  *   gather   Pi_p = sum w Jbar_i,  dFbar = (Pi_p / (Jbar_p^n dJ_p))^(1/dim) dF (step 4)
+ * with j_p = Jbar_p^n dJ_p in MPMC_FBAR_PAPER (eq 26, Algorithm 1 as published) and
+ * j_p = J_p^{n+1} = det F in MPMC_FBAR_TOTAL (eqs 18-21: the projection of the Jacobian
+ * itself, inserted in eq 25).  The paper's recursion re-projects Jbar every step, so in a
+ * long quasi-static run the smoothing of a non-uniform Jbar near boundaries accumulates
+ * into a creep of the true volume (docs/theory.md); the total form has no such memory.
  * V_p is the volume at t^n, recovered as V0 J^{n+1} / dJ (G2P has already updated J).
  * Touches nothing but dF (handed to the material) and Jbar. */
 #include <math.h>
@@ -18,13 +23,14 @@ MPMC_ALWAYS_INLINE void scatter_impl(mpmc_sim sim, const int DIM, const int BASI
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   double *restrict gvol = g->vol, *restrict gjv = g->jv;
+  const int total = sim->fbar == MPMC_FBAR_TOTAL;
   for (int q = 0; q < p->n; ++q) {
     mpmc_pw pw;
     mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
                        BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
     const double dJ = det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
     const double Vn = p->vol0[q] * p->J[q] / dJ;
-    const double val = p->Jbar[q] * dJ;
+    const double val = total ? p->J[q] : p->Jbar[q] * dJ;
     MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
       gvol[node] += w * Vn;
       gjv[node] += w * Vn * val;
@@ -37,7 +43,7 @@ MPMC_ALWAYS_INLINE void gather_impl(mpmc_sim sim, const int DIM, const int BASIS
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double *restrict gjb = g->jv;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     mpmc_pw pw;
     mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
@@ -59,7 +65,7 @@ int mpmc_fbar(mpmc_sim sim) {
   MPMC_DISPATCH(scatter_impl, sim, 0);
   /* nodal volume average (Algorithm 1 step 3) */
   const long nn = (long)g->nn;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn > MPMC_OMP_MIN)
   for (long i = 0; i < nn; ++i) g->jv[i] = g->vol[i] > 0.0 ? g->jv[i] / g->vol[i] : 0.0;
   MPMC_DISPATCH(gather_impl, sim, 0);
   /* the projection used the weights at x^n; now the points move (eq 17) */

@@ -23,7 +23,7 @@ MPMC_ALWAYS_INLINE void g2p_impl(mpmc_sim sim, const int DIM, const int BASIS, d
     xmax[a] = g->hi[a] + g->h;
   }
   int first_bad = INT_MAX;
-#pragma omp parallel for schedule(static) reduction(min : first_bad)
+#pragma omp parallel for schedule(static) reduction(min : first_bad) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     const size_t qd = (size_t)q * DIM;
     mpmc_pw pw;

@@ -10,7 +10,7 @@ static int hencky_update(mpmc_sim sim, const mpmc_material *mat, int id, double 
   mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   const double K = mat->K, G2 = 2.0 * mat->G;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     if (p->mat[q] != id) continue;
     double F[3][3], lam[3], Q[3][3], eps[3], tau[3];

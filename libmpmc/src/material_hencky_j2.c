@@ -1,13 +1,168 @@
-/* TEMPORARY: replaced by the Hencky-J2 implementation (issue 3). */
+/* Hencky elasticity with von Mises (J2) plasticity and exponential softening, return
+ * mapping in principal logarithmic strain space (formulas.md, "Hencky-J2"; the paper's
+ * footing and landslide models):
+ *   trial  b_e = dF b_e^n dF^T  (dF-bar with F-bar on), b_e = sum lam_a n_a n_a^T,
+ *          eps_a = 1/2 ln lam_a,  tau_a = K tr(eps) + 2G dev(eps)_a,
+ *   yield  q = sqrt(3/2) |dev tau| <= kappa(eps_p) = kappa_r + (kappa_p - kappa_r) e^(-eta eps_p),
+ *   return radial on the deviator: dev eps <- (1 - 3G dgamma / q_trial) dev eps,
+ *          eps_p <- eps_p + dgamma, dgamma from return_map.c.
+ * The volumetric part is untouched (isochoric flow), so J = exp(tr eps) is the Jacobian the
+ * material sees (J-bar with F-bar) and sigma = tau / J. */
+#include <limits.h>
 #include <math.h>
+#include <stdint.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
-#include "mpmc_impl.h"
+#include "linalg.h"
+#include "return_map.h"
+
+/**
+ * @brief Return map of one point (return_map.h); private, used by the tests and bench/.
+ */
+int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],
+                       double *be, double *eps_p, double *tau, double *J_out,
+                       mpmc_j2_info *info) {
+  mpmc_j2_info local = {0};
+  if (!info) info = &local;
+  double b[6], lam[3], Q[3][3], eps[3], e[3], s[3];
+  for (int k = 0; k < 6; ++k) b[k] = be[k];
+  if (F) mpmc_push_forward(F, b);
+  mpmc_sym3_eig(b, lam, Q);
+  for (int a = 0; a < 3; ++a)
+    if (!(lam[a] > 0.0) || !isfinite(lam[a])) return MPMC_ERR_NUMERIC;
+  for (int a = 0; a < 3; ++a) eps[a] = 0.5 * log(lam[a]);
+  const double tr = eps[0] + eps[1] + eps[2];
+  double ss = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    e[a] = eps[a] - tr / 3.0;
+    s[a] = 2.0 * m->G * e[a];
+    ss += s[a] * s[a];
+  }
+  const double qtr = sqrt(1.5 * ss);
+  const double k0 = mpmc_j2_kappa(m, *eps_p);
+  info->q_trial = qtr;
+  info->kappa = k0;
+  info->plastic = 0;
+  info->dgamma = 0.0;
+  if (!isfinite(qtr)) return MPMC_ERR_NUMERIC;
+  double t[3];
+  if (qtr > k0) {
+    double dg, qn;
+    info->plastic = 1;
+    MPMC_CALL(mpmc_rm_solve(ws, solver, m, qtr, *eps_p, &dg, &qn, info));
+    const double f = qn / qtr; /* radial return: = 1 - 3G dgamma / q_trial */
+    double lnew[3];
+    for (int a = 0; a < 3; ++a) {
+      e[a] *= f;
+      s[a] *= f;
+      lnew[a] = exp(2.0 * (e[a] + tr / 3.0));
+    }
+    mpmc_sym3_compose(lnew, Q, be);
+    *eps_p += dg;
+  } else {
+    for (int k = 0; k < 6; ++k) be[k] = b[k]; /* elastic: keep b_e as pushed forward */
+  }
+  for (int a = 0; a < 3; ++a) t[a] = m->K * tr + s[a];
+  mpmc_sym3_compose(t, Q, tau);
+  if (J_out) *J_out = exp(tr);
+  return MPMC_SUCCESS;
+}
+
+static const char *solver_name(int solver) {
+  return solver == MPMC_SOLVER_NEWTON ? "newton" : solver == MPMC_SOLVER_KINSOL ? "kinsol" : "auto";
+}
 
 static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) {
-  (void)mat; (void)id; (void)dt;
-  return MPMC_ERROR(sim->ctx, MPMC_ERR_UNSUPPORTED, "hencky_j2 not implemented yet");
+  (void)dt;
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim, solver = sim->solver;
+  const mpmc_j2_param par = {mat->K, mat->G, mat->kappa_p, mat->kappa_r, mat->eta};
+  int nthreads = 1;
+#ifdef _OPENMP
+  nthreads = omp_get_max_threads();
+#endif
+  mpmc_rm_ws **ws;
+  MPMC_CALL(mpmc_rm_sim_workspaces(sim, nthreads, &ws));
+  int64_t nret = 0, nfb = 0;
+  int first_bad = INT_MAX;
+  /* threads only pay off beyond a few hundred points (a parallel region costs ~us, far
+     more when the cores are shared) */
+#pragma omp parallel if (p->n >= 256) reduction(+ : nret, nfb) reduction(min : first_bad)
+  {
+    int tid = 0;
+#ifdef _OPENMP
+    tid = omp_get_thread_num();
+#endif
+    mpmc_rm_ws *w = ws[tid];
+#pragma omp for schedule(static)
+    for (int q = 0; q < p->n; ++q) {
+      if (p->mat[q] != id) continue;
+      double F[3][3], tau[6], J;
+      mpmc_j2_info info = {0};
+      mpmc_embed(d, p->dF + (size_t)q * d * d, F);
+      const int err = mpmc_j2_return_map(w, solver, &par, F, p->be + (size_t)q * 6, p->eps_p + q,
+                                         tau, &J, &info);
+      if (err) {
+        if (q < first_bad) first_bad = q;
+        continue;
+      }
+      nret += info.plastic;
+      nfb += info.fallback;
+      double *sg = p->stress + (size_t)q * 6;
+      const double inv_J = 1.0 / J;
+      for (int k = 0; k < 6; ++k) sg[k] = tau[k] * inv_J;
+    }
+  }
+  sim->stats.return_maps += nret;
+  sim->stats.kinsol_fallbacks += nfb;
+  if (first_bad == INT_MAX) return MPMC_SUCCESS;
+  /* a failed point's state is unchanged: repeat it alone to report what went wrong */
+  const int q = first_bad;
+  double F[3][3], tau[6], J, be[6], ep = p->eps_p[q];
+  mpmc_j2_info info = {0};
+  for (int k = 0; k < 6; ++k) be[k] = p->be[(size_t)q * 6 + k];
+  mpmc_embed(d, p->dF + (size_t)q * d * d, F);
+  const int err = mpmc_j2_return_map(ws[0], solver, &par, F, be, &ep, tau, &J, &info);
+  const double *x = p->x + (size_t)q * d;
+  return MPMC_ERROR(sim->ctx, err ? err : MPMC_ERR_SOLVER,
+                    "step %lld, t = %g: return map of point %d at (%g, %g, %g) (material %d, "
+                    "solver %s) failed: trial q = %g, kappa = %g, eps_p = %g, dgamma = %g, "
+                    "|g| = %g, KINSOL flag %d",
+                    (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0, id,
+                    solver_name(solver), info.q_trial, info.kappa, p->eps_p[q], info.dgamma,
+                    info.residual, info.kinsol_flag);
 }
+
 static double j2_wave_speed(const mpmc_material *m) {
   return sqrt((m->K + 4.0 / 3.0 * m->G) / m->rho);
 }
+
 const mpmc_material_ops mpmc_ops_hencky_j2 = {"hencky_j2", j2_update, j2_wave_speed};
+
+/**
+ * @brief Add Hencky-J2 with the strengths given as undrained shear strengths su.
+ *
+ * For von Mises plasticity the shear strength is su = kappa / sqrt(3) (pure or simple
+ * shear, in particular plane-strain shear, which is what the footing's "su under plane
+ * strain" means), so kappa_p = sqrt(3) su_p and kappa_r = sqrt(3) su_r.
+ * @param su_p peak undrained shear strength [Pa], > 0
+ * @param su_r residual undrained shear strength [Pa], 0 < su_r <= su_p
+ * @param eta softening rate, >= 0
+ * @param[out] id the material's id (may be NULL)
+ */
+int mpmc_sim_add_material_hencky_j2_su(mpmc_sim sim, double E, double nu, double rho, double su_p,
+                                       double su_r, double eta, int *id) {
+  if (!sim) return MPMC_ERR_ARG;
+  mpmc_context ctx = sim->ctx;
+  MPMC_CHECK(isfinite(su_p) && su_p > 0, ctx, MPMC_ERR_ARG,
+             "peak undrained shear strength su_p = %g must be > 0", su_p);
+  MPMC_CHECK(isfinite(su_r) && su_r > 0, ctx, MPMC_ERR_ARG,
+             "residual undrained shear strength su_r = %g must be > 0", su_r);
+  MPMC_CHECK(su_r <= su_p, ctx, MPMC_ERR_ARG,
+             "residual shear strength su_r = %g must not exceed peak shear strength su_p = %g",
+             su_r, su_p);
+  const double s3 = sqrt(3.0);
+  return mpmc_sim_add_material_hencky_j2(sim, E, nu, rho, s3 * su_p, s3 * su_r, eta, id);
+}

@@ -11,7 +11,7 @@ static int nh_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) 
   mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   const double mu = mat->G, lam = mat->lambda;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     if (p->mat[q] != id) continue;
     double F[3][3];

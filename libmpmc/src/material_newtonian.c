@@ -9,7 +9,7 @@ static int newtonian_update(mpmc_sim sim, const mpmc_material *mat, int id, doub
   const int d = sim->dim;
   const double K = mat->K, mu2 = 2.0 * mat->mu, inv_dt = dt > 0 ? 1.0 / dt : 0.0;
   const double *Jm = sim->fbar ? p->Jbar : p->J;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     if (p->mat[q] != id) continue;
     const double *f = p->dF + (size_t)q * d * d;

@@ -7,6 +7,10 @@
 
 #include "mpmc.h"
 
+/* Parallel loops run on one thread below this many items: forking and joining the team
+ * costs more than it saves for small scenes, and far more on a loaded machine. */
+#define MPMC_OMP_MIN 4096
+
 /* ---- context and errors (context.c, error.c) ---------------------------------- */
 #define MPMC_MSG_LEN 1024
 struct mpmc_context_s {
@@ -119,12 +123,18 @@ struct mpmc_material_s {
   double mu;                                /* fluid viscosity                       */
   int solid;                                /* needs be                              */
   int plastic;                              /* needs eps_p                           */
+  /* user material (material_user.c) */
+  mpmc_user_stress_fn user_fn;              /* the caller's stress update            */
+  void *user_data;                          /* handed back to user_fn                */
+  int user_nstate;                          /* state variables it uses per point     */
+  double user_wave_speed;                   /* p-wave speed for the stable time step */
 };
 
 extern const mpmc_material_ops mpmc_ops_neo_hookean;
 extern const mpmc_material_ops mpmc_ops_hencky;
 extern const mpmc_material_ops mpmc_ops_hencky_j2;
 extern const mpmc_material_ops mpmc_ops_newtonian;
+extern const mpmc_material_ops mpmc_ops_user;
 
 /* ---- walls (boundary.c) ------------------------------------------------------------ */
 typedef struct {
@@ -132,6 +142,14 @@ typedef struct {
   int kind, axis, side;
   double lo[3], hi[3]; /* the constrained region (infinite in unbounded directions) */
 } mpmc_wall;
+
+/* A wall on a node plane, unbounded along the other axes: the ghost nodes beyond it take the
+ * mirror image of the velocities inside (odd for constrained components, even for free
+ * ones), so that B-splines see a wall at the plane instead of a clamped layer of ghosts. */
+typedef struct {
+  int axis, side, plane; /* plane: node index of the wall along axis */
+  unsigned odd;          /* bit a: component a is reflected with a sign change */
+} mpmc_mirror;
 
 /* ---- the simulation ---------------------------------------------------------------- */
 struct mpmc_sim_s {
@@ -152,6 +170,8 @@ struct mpmc_sim_s {
   mpmc_wall *walls;
   int nwall, capwall;
   int walls_dirty;    /* recompute the node constraint flags                           */
+  mpmc_mirror *mirrors; /* derived from the walls by mpmc_boundary_apply_flags          */
+  int nmirror;
   int prepared;       /* fields and grid arrays match the configuration               */
   double time;
   mpmc_stats stats;
@@ -178,6 +198,8 @@ void mpmc_return_map_free(struct mpmc_sim_s *sim);
 int mpmc_contact_update(struct mpmc_sim_s *sim, double dt);
 double mpmc_contact_stable_dt(const struct mpmc_sim_s *sim);
 void mpmc_contact_free(struct mpmc_sim_s *sim);
+/* after the step: a point that crossed into a body fails the step (MPMC_ERR_NUMERIC) */
+int mpmc_contact_check(struct mpmc_sim_s *sim);
 /* sets.c */
 void mpmc_sets_free(struct mpmc_sim_s *sim);
 int mpmc_material_validate_elastic(mpmc_context ctx, double E, double nu, double rho);

@@ -39,6 +39,7 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   mpmc_grid_free(&s->grid);
   free(s->mats);
   free(s->walls);
+  free(s->mirrors);
   free(s);
   *sim = NULL;
   return MPMC_SUCCESS;
@@ -93,12 +94,15 @@ int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
   return MPMC_SUCCESS;
 }
 
-/** @brief Switch the F-bar projection (paper Algorithm 1) on (1) or off (0). */
-int mpmc_sim_set_fbar(mpmc_sim sim, int enabled) {
+/**
+ * @brief Choose the F-bar projection: MPMC_FBAR_OFF (0), MPMC_FBAR_PAPER (1, Algorithm 1 as
+ * published) or MPMC_FBAR_TOTAL (2, the projection of det F).
+ */
+int mpmc_sim_set_fbar(mpmc_sim sim, int mode) {
   if (!sim) return MPMC_ERR_ARG;
-  MPMC_CHECK(enabled == 0 || enabled == 1, sim->ctx, MPMC_ERR_ARG, "fbar = %d must be 0 or 1",
-             enabled);
-  sim->fbar = enabled;
+  MPMC_CHECK(mode >= MPMC_FBAR_OFF && mode <= MPMC_FBAR_TOTAL, sim->ctx, MPMC_ERR_ARG,
+             "fbar = %d is not one of off (0), paper (1), total (2)", mode);
+  sim->fbar = mode;
   sim->prepared = 0;
   return MPMC_SUCCESS;
 }
@@ -372,7 +376,7 @@ int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke) {
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   double e = 0.0;
-#pragma omp parallel for reduction(+ : e) schedule(static)
+#pragma omp parallel for reduction(+ : e) schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     double v2 = 0.0;
     for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];

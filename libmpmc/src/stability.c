@@ -17,7 +17,7 @@ double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
     }
   }
   double vmax = 0.0;
-#pragma omp parallel for reduction(max : vmax) schedule(static)
+#pragma omp parallel for reduction(max : vmax) schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     double v2 = 0.0;
     for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];

@@ -20,6 +20,7 @@ static int step_phases(mpmc_sim sim, double dt) {
   MPMC_CALL(mpmc_g2p(sim, dt));          /* v, dF, J, x                 (eqs 13-17)    */
   if (sim->fbar) MPMC_CALL(mpmc_fbar(sim)); /* dF -> dF-bar             (Alg. 1, 2-4)  */
   MPMC_CALL(mpmc_stress_update(sim, dt)); /* material update with dF(-bar)             */
+  if (sim->bodies) MPMC_CALL(mpmc_contact_check(sim)); /* no point inside a rigid body */
   return MPMC_SUCCESS;
 }
 
@@ -36,22 +37,23 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   MPMC_CHECK(sim->nmat > 0 && sim->p.n > 0, ctx, MPMC_ERR_STATE,
              "nothing to step: add a material and material points first");
   MPMC_CALL(mpmc_sim_prepare(sim));
-  if (!sim->force_dt) {
-    const double limit = mpmc_stability_limit(sim, 1.0);
-    MPMC_CHECK(dt <= limit, ctx, MPMC_ERR_UNSTABLE,
-               "dt = %g exceeds the stability limit h/(c + |v|max) = %g (h = %g); use dt <= %g "
-               "(factor 0.3-0.4) or force it",
-               dt, limit, sim->grid.h, limit);
-  }
-  const double t0 = now();
-  int err;
 #ifdef _OPENMP
   const int saved = omp_get_max_threads();
   if (sim->nthreads > 0) omp_set_num_threads(sim->nthreads);
-  err = step_phases(sim, dt);
+#endif
+  int err = MPMC_SUCCESS;
+  if (!sim->force_dt) {
+    const double limit = mpmc_stability_limit(sim, 1.0);
+    if (!(dt <= limit))
+      err = MPMC_ERROR(ctx, MPMC_ERR_UNSTABLE,
+                       "dt = %g exceeds the stability limit h/(c + |v|max) = %g (h = %g); use dt "
+                       "<= %g (factor 0.3-0.4) or force it",
+                       dt, limit, sim->grid.h, limit);
+  }
+  const double t0 = now();
+  if (!err) err = step_phases(sim, dt);
+#ifdef _OPENMP
   if (sim->nthreads > 0) omp_set_num_threads(saved);
-#else
-  err = step_phases(sim, dt);
 #endif
   if (err) return err;
   sim->time += dt;

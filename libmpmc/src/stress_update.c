@@ -11,7 +11,7 @@ int mpmc_stress_update(mpmc_sim sim, double dt) {
     MPMC_CALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, dt));
   const mpmc_particles *p = &sim->p;
   int first_bad = INT_MAX;
-#pragma omp parallel for schedule(static) reduction(min : first_bad)
+#pragma omp parallel for schedule(static) reduction(min : first_bad) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     const double *s = p->stress + (size_t)q * 6;
     const double sum = s[0] + s[1] + s[2] + s[3] + s[4] + s[5];

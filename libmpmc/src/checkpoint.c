@@ -1,0 +1,574 @@
+/* Checkpoint and restart: one HDF5 file holding everything needed to continue a run
+ * bit for bit (configuration, grid, materials, every allocated particle array, walls,
+ * particle sets, run statistics and the caller's text).  Written atomically: the file is
+ * built as path.tmp, flushed and fsync'ed, then renamed over path, so a process killed
+ * during the write leaves the previous checkpoint intact.
+ *
+ * The file is a list of blocks; each block is a writer and a reader below and one line in
+ * `blocks`.  Not saved: user-material functions (the caller re-attaches them with
+ * mpmc_sim_set_material_user_fn), rigid bodies (a sim with bodies refuses to checkpoint
+ * until contact_barrier.c gets a block), and scratch arrays (dF, xn, grid arrays) that
+ * every step recomputes. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "io.h"
+#include "sets.h"
+
+#define CKPT_FORMAT "libmpmc-checkpoint"
+#define CKPT_VERSION 1
+
+/* ---- small HDF5 helpers --------------------------------------------------------------- */
+
+/* Read dataset `name` of shape [rows] (cols == 0) or [rows][cols] into buf; < 0 if absent
+ * or of another shape. */
+static herr_t read_dataset(hid_t loc, const char *name, hid_t memtype, size_t rows, size_t cols,
+                           void *buf) {
+  if (H5Lexists(loc, name, H5P_DEFAULT) <= 0) return -1;
+  hid_t ds = H5Dopen2(loc, name, H5P_DEFAULT);
+  if (ds < 0) return -1;
+  hid_t sp = H5Dget_space(ds);
+  hsize_t dims[2] = {0, 0};
+  const int rank = sp < 0 ? -1 : H5Sget_simple_extent_ndims(sp);
+  herr_t st = -1;
+  if (rank == (cols ? 2 : 1)) {
+    H5Sget_simple_extent_dims(sp, dims, NULL);
+    if (dims[0] == rows && (!cols || dims[1] == cols))
+      st = rows ? H5Dread(ds, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) : 0;
+  }
+  if (sp >= 0) H5Sclose(sp);
+  H5Dclose(ds);
+  return st;
+}
+
+static int exists(hid_t loc, const char *name) { return H5Lexists(loc, name, H5P_DEFAULT) > 0; }
+
+/* ---- block: configuration, grid, time, statistics ----------------------------------------- */
+
+static int write_config(hid_t f, const mpmc_sim sim) {
+  hid_t g = H5Gcreate2(f, "config", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (g < 0) return -1;
+  const mpmc_grid *gr = &sim->grid;
+  const int ints[] = {sim->dim, sim->basis, sim->fbar, sim->solver, sim->nthreads, sim->force_dt};
+  const int64_t stats[] = {sim->stats.steps, sim->stats.particle_steps, sim->stats.return_maps,
+                           sim->stats.kinsol_fallbacks};
+  herr_t st = 0;
+  st |= mpmc_h5_attr_write(g, "dim_basis_fbar_solver_nthreads_forcedt", H5T_NATIVE_INT, 6, ints);
+  st |= mpmc_h5_attr_write(g, "flip", H5T_NATIVE_DOUBLE, 1, &sim->flip);
+  st |= mpmc_h5_attr_write(g, "gravity", H5T_NATIVE_DOUBLE, 3, sim->gravity);
+  st |= mpmc_h5_attr_write(g, "damping", H5T_NATIVE_DOUBLE, 1, &sim->damping);
+  st |= mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &sim->time);
+  st |= mpmc_h5_attr_write(g, "grid_lo", H5T_NATIVE_DOUBLE, 3, gr->lo);
+  st |= mpmc_h5_attr_write(g, "grid_hi", H5T_NATIVE_DOUBLE, 3, gr->hi);
+  st |= mpmc_h5_attr_write(g, "grid_h", H5T_NATIVE_DOUBLE, 1, &gr->h);
+  st |= mpmc_h5_attr_write(g, "stats_steps_particlesteps_returnmaps_kinsol", H5T_NATIVE_INT64, 4,
+                           stats);
+  st |= mpmc_h5_attr_write(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1,
+                           &sim->stats.wall_seconds);
+  H5Gclose(g);
+  return st < 0 ? -1 : 0;
+}
+
+/* The configuration goes through the public setters, which validate it. */
+static int read_config(hid_t f, mpmc_sim sim) {
+  mpmc_context ctx = sim->ctx;
+  hid_t g = exists(f, "config") ? H5Gopen2(f, "config", H5P_DEFAULT) : -1;
+  MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /config group");
+  int ints[6];
+  int64_t stats[4];
+  double flip, grav[3], damp, time, lo[3], hi[3], h, wall;
+  herr_t st = 0;
+  st |= mpmc_h5_attr_read(g, "dim_basis_fbar_solver_nthreads_forcedt", H5T_NATIVE_INT, 6, ints);
+  st |= mpmc_h5_attr_read(g, "flip", H5T_NATIVE_DOUBLE, 1, &flip);
+  st |= mpmc_h5_attr_read(g, "gravity", H5T_NATIVE_DOUBLE, 3, grav);
+  st |= mpmc_h5_attr_read(g, "damping", H5T_NATIVE_DOUBLE, 1, &damp);
+  st |= mpmc_h5_attr_read(g, "time", H5T_NATIVE_DOUBLE, 1, &time);
+  st |= mpmc_h5_attr_read(g, "grid_lo", H5T_NATIVE_DOUBLE, 3, lo);
+  st |= mpmc_h5_attr_read(g, "grid_hi", H5T_NATIVE_DOUBLE, 3, hi);
+  st |= mpmc_h5_attr_read(g, "grid_h", H5T_NATIVE_DOUBLE, 1, &h);
+  st |= mpmc_h5_attr_read(g, "stats_steps_particlesteps_returnmaps_kinsol", H5T_NATIVE_INT64, 4,
+                          stats);
+  st |= mpmc_h5_attr_read(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1, &wall);
+  H5Gclose(g);
+  MPMC_CHECK(st >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint /config: missing or malformed attributes");
+  MPMC_CHECK(ints[0] == sim->dim, ctx, MPMC_ERR_FORMAT,
+             "checkpoint /config: dim = %d differs from the file's dim = %d", ints[0], sim->dim);
+  MPMC_CALL(mpmc_sim_set_basis(sim, ints[1]));
+  MPMC_CALL(mpmc_sim_set_fbar(sim, ints[2]));
+  MPMC_CALL(mpmc_sim_set_solver(sim, ints[3]));
+  MPMC_CALL(mpmc_sim_set_threads(sim, ints[4]));
+  MPMC_CALL(mpmc_sim_set_force_dt(sim, ints[5]));
+  MPMC_CALL(mpmc_sim_set_flip_blend(sim, flip));
+  MPMC_CALL(mpmc_sim_set_gravity(sim, grav));
+  MPMC_CALL(mpmc_sim_set_damping(sim, damp));
+  MPMC_CALL(mpmc_sim_set_time(sim, time));
+  MPMC_CALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  for (int a = 0; a < sim->dim; ++a)
+    MPMC_CHECK(sim->grid.hi[a] == hi[a], ctx, MPMC_ERR_FORMAT,
+               "checkpoint /config: grid axis %d does not hold whole cells (hi %g, rebuilt %g)", a,
+               hi[a], sim->grid.hi[a]);
+  sim->stats.steps = stats[0];
+  sim->stats.particle_steps = stats[1];
+  sim->stats.return_maps = stats[2];
+  sim->stats.kinsol_fallbacks = stats[3];
+  sim->stats.wall_seconds = wall;
+  return MPMC_SUCCESS;
+}
+
+/* ---- block: materials ------------------------------------------------------------------------ */
+
+#define NPARAM 14 /* rho E nu K G lambda kappa_p kappa_r eta mu solid plastic nstate wave */
+
+static int write_materials(hid_t f, const mpmc_sim sim) {
+  const int nm = sim->nmat;
+  double *par = malloc(sizeof(double) * NPARAM * (size_t)(nm > 0 ? nm : 1));
+  int *kind = malloc(sizeof(int) * (size_t)(nm > 0 ? nm : 1));
+  herr_t st = par && kind ? 0 : -1;
+  for (int i = 0; i < nm && st == 0; ++i) {
+    const mpmc_material *m = &sim->mats[i];
+    const double v[NPARAM] = {m->rho,     m->E,       m->nu, m->K,  m->G,     m->lambda,
+                              m->kappa_p, m->kappa_r, m->eta, m->mu, m->solid, m->plastic,
+                              m->user_nstate, m->user_wave_speed};
+    memcpy(par + (size_t)i * NPARAM, v, sizeof v);
+    kind[i] = m->kind;
+  }
+  hid_t g = st == 0 ? H5Gcreate2(f, "materials", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT) : -1;
+  if (g < 0) st = -1;
+  if (st == 0) {
+    st |= mpmc_h5_attr_write(g, "count", H5T_NATIVE_INT, 1, &nm);
+    st |= mpmc_h5_dataset_write(g, "kind", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)nm, 0, kind);
+    st |= mpmc_h5_dataset_write(g, "params", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)nm,
+                                NPARAM, par);
+    st |= mpmc_h5_attr_write_string(
+        g, "params_columns",
+        "rho E nu K G lambda kappa_p kappa_r eta mu solid plastic user_nstate user_wave_speed");
+  }
+  if (g >= 0) H5Gclose(g);
+  free(par);
+  free(kind);
+  return st < 0 ? -1 : 0;
+}
+
+/* A restored user material until the caller re-attaches its function. */
+static int unattached_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
+  (void)mat;
+  (void)dt;
+  return MPMC_ERROR(sim->ctx, MPMC_ERR_STATE,
+                    "user material %d was restored from a checkpoint without its function: "
+                    "call mpmc_sim_set_material_user_fn first",
+                    id);
+}
+static double unattached_wave_speed(const mpmc_material *m) { return m->user_wave_speed; }
+static const mpmc_material_ops ops_unattached = {"user (unattached)", unattached_update,
+                                                 unattached_wave_speed};
+
+static int read_materials(hid_t f, mpmc_sim sim) {
+  mpmc_context ctx = sim->ctx;
+  hid_t g = exists(f, "materials") ? H5Gopen2(f, "materials", H5P_DEFAULT) : -1;
+  MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /materials group");
+  int nm = -1;
+  if (mpmc_h5_attr_read(g, "count", H5T_NATIVE_INT, 1, &nm) < 0 || nm < 0 || nm > 1000000) {
+    H5Gclose(g);
+    return MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /materials: bad count %d", nm);
+  }
+  double *par = malloc(sizeof(double) * NPARAM * (size_t)(nm > 0 ? nm : 1));
+  int *kind = malloc(sizeof(int) * (size_t)(nm > 0 ? nm : 1));
+  sim->mats = calloc((size_t)(nm > 0 ? nm : 1), sizeof *sim->mats);
+  herr_t st = par && kind && sim->mats ? 0 : -1;
+  if (st == 0) st |= read_dataset(g, "kind", H5T_NATIVE_INT, (size_t)nm, 0, kind);
+  if (st == 0) st |= read_dataset(g, "params", H5T_NATIVE_DOUBLE, (size_t)nm, NPARAM, par);
+  H5Gclose(g);
+  int err = st < 0 ? MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
+                                "checkpoint /materials: kind/params datasets missing or not [%d][%d]",
+                                nm, NPARAM)
+                   : MPMC_SUCCESS;
+  sim->capmat = nm > 0 ? nm : 1;
+  for (int i = 0; i < nm && !err; ++i) {
+    mpmc_material *m = &sim->mats[i];
+    const double *v = par + (size_t)i * NPARAM;
+    m->kind = kind[i];
+    m->rho = v[0], m->E = v[1], m->nu = v[2], m->K = v[3], m->G = v[4], m->lambda = v[5];
+    m->kappa_p = v[6], m->kappa_r = v[7], m->eta = v[8], m->mu = v[9];
+    m->solid = (int)v[10], m->plastic = (int)v[11];
+    m->user_nstate = (int)v[12], m->user_wave_speed = v[13];
+    switch (kind[i]) {
+      case MPMC_MAT_NEO_HOOKEAN: m->ops = &mpmc_ops_neo_hookean; break;
+      case MPMC_MAT_HENCKY: m->ops = &mpmc_ops_hencky; break;
+      case MPMC_MAT_HENCKY_J2: m->ops = &mpmc_ops_hencky_j2; break;
+      case MPMC_MAT_NEWTONIAN: m->ops = &mpmc_ops_newtonian; break;
+      case MPMC_MAT_USER: m->ops = &ops_unattached; break;
+      default:
+        err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint material %d: unknown kind %d", i,
+                         kind[i]);
+    }
+    if (!err && !(isfinite(m->rho) && m->rho > 0))
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint material %d: density %g", i, m->rho);
+    if (!err) sim->nmat = i + 1;
+  }
+  free(par);
+  free(kind);
+  return err;
+}
+
+/**
+ * @brief Re-attach the stress function of user material `material` after
+ *        mpmc_sim_checkpoint_read (function pointers cannot be saved in a file).
+ * @param fn the same stress update the material was created with, not NULL
+ * @param data passed back to fn (may be NULL)
+ */
+int mpmc_sim_set_material_user_fn(mpmc_sim sim, int material, mpmc_user_stress_fn fn, void *data) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(material >= 0 && material < sim->nmat, sim->ctx, MPMC_ERR_ARG,
+             "material id %d does not exist (%d materials)", material, sim->nmat);
+  MPMC_CHECK(sim->mats[material].kind == MPMC_MAT_USER, sim->ctx, MPMC_ERR_ARG,
+             "material %d is a '%s' material, not a user material", material,
+             sim->mats[material].ops->name);
+  MPMC_CHECK(fn, sim->ctx, MPMC_ERR_ARG, "user material %d: stress function fn is NULL", material);
+  sim->mats[material].user_fn = fn;
+  sim->mats[material].user_data = data;
+  sim->mats[material].ops = &mpmc_ops_user;
+  return MPMC_SUCCESS;
+}
+
+/* ---- block: particles --------------------------------------------------------------------- */
+
+/* Every double array of the particle store that a checkpoint carries; NULL ones are skipped
+ * on writing and left unallocated on reading.  ncomp: 0 = dim, -1 = nustate. */
+typedef struct {
+  const char *name;
+  size_t off;
+  int ncomp;
+  int required;
+} pfield;
+#define PF(f, nc, req) {#f, offsetof(mpmc_particles, f), nc, req}
+static const pfield pfields[] = {PF(x, 0, 1),     PF(x0, 0, 1),     PF(v, 0, 1),
+                                 PF(m, 1, 1),     PF(vol0, 1, 1),   PF(J, 1, 1),
+                                 PF(stress, 6, 1), PF(Jbar, 1, 0),  PF(be, 6, 0),
+                                 PF(eps_p, 1, 0), PF(lp, 1, 0),     PF(force, 0, 0),
+                                 PF(cforce, 0, 0), PF(ustate, -1, 0)};
+#undef PF
+
+static double **pfield_ptr(mpmc_particles *p, const pfield *f) {
+  return (double **)(void *)((char *)p + f->off);
+}
+static int pfield_ncomp(const mpmc_particles *p, const pfield *f) {
+  return f->ncomp == 0 ? p->dim : f->ncomp < 0 ? p->nustate : f->ncomp;
+}
+
+static int write_particles(hid_t f, const mpmc_sim sim) {
+  mpmc_particles *p = (mpmc_particles *)&sim->p;
+  hid_t g = H5Gcreate2(f, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (g < 0) return -1;
+  herr_t st = 0;
+  st |= mpmc_h5_attr_write(g, "n", H5T_NATIVE_INT, 1, &p->n);
+  st |= mpmc_h5_attr_write(g, "nustate", H5T_NATIVE_INT, 1, &p->nustate);
+  for (size_t k = 0; k < sizeof pfields / sizeof pfields[0] && st >= 0; ++k) {
+    const double *a = *pfield_ptr(p, &pfields[k]);
+    const int nc = pfield_ncomp(p, &pfields[k]);
+    if (!a || nc == 0) continue;
+    st |= mpmc_h5_dataset_write(g, pfields[k].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                                (size_t)p->n, nc > 1 ? (size_t)nc : 0, a);
+  }
+  if (st >= 0)
+    st |= mpmc_h5_dataset_write(g, "mat", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)p->n, 0, p->mat);
+  H5Gclose(g);
+  return st < 0 ? -1 : 0;
+}
+
+static int read_particles(hid_t f, mpmc_sim sim) {
+  mpmc_context ctx = sim->ctx;
+  mpmc_particles *p = &sim->p;
+  hid_t g = exists(f, "particles") ? H5Gopen2(f, "particles", H5P_DEFAULT) : -1;
+  MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /particles group");
+  int n = -1, nus = -1;
+  int err = MPMC_SUCCESS;
+  if (mpmc_h5_attr_read(g, "n", H5T_NATIVE_INT, 1, &n) < 0 || n < 0 ||
+      mpmc_h5_attr_read(g, "nustate", H5T_NATIVE_INT, 1, &nus) < 0 || nus < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles: bad n = %d or nustate = %d", n,
+                     nus);
+  if (!err) err = mpmc_particles_reserve(ctx, p, n > 64 ? n : 64);
+  if (!err) {
+    p->n = n;
+    p->nustate = nus;
+  }
+  for (size_t k = 0; k < sizeof pfields / sizeof pfields[0] && !err; ++k) {
+    const pfield *pf = &pfields[k];
+    double **a = pfield_ptr(p, pf);
+    const int nc = pfield_ncomp(p, pf);
+    if (!exists(g, pf->name)) {
+      if (pf->required || (pf->ncomp < 0 && nc > 0))
+        err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles: dataset '%s' is missing",
+                         pf->name);
+      continue;
+    }
+    if (!*a) err = mpmc_particles_ensure(ctx, p, a, nc, 0.0);
+    if (!err && read_dataset(g, pf->name, H5T_NATIVE_DOUBLE, (size_t)n, nc > 1 ? (size_t)nc : 0,
+                             *a) < 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
+                       "checkpoint /particles/%s: unreadable or not of shape [%d][%d]", pf->name,
+                       n, nc);
+  }
+  if (!err && read_dataset(g, "mat", H5T_NATIVE_INT, (size_t)n, 0, p->mat) < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles/mat: missing or not [%d]", n);
+  for (int q = 0; q < n && !err; ++q)
+    if (p->mat[q] < 0 || p->mat[q] >= sim->nmat)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint point %d: material id %d of %d", q,
+                       p->mat[q], sim->nmat);
+  H5Gclose(g);
+  return err;
+}
+
+/* ---- block: walls ------------------------------------------------------------------------- */
+
+#define WALLCOLS 10 /* active kind axis side lo[3] hi[3] */
+
+static int write_walls(hid_t f, const mpmc_sim sim) {
+  const int nw = sim->nwall;
+  double *w = malloc(sizeof(double) * WALLCOLS * (size_t)(nw > 0 ? nw : 1));
+  if (!w) return -1;
+  for (int i = 0; i < nw; ++i) {
+    const mpmc_wall *s = &sim->walls[i];
+    double *r = w + (size_t)i * WALLCOLS;
+    r[0] = s->active, r[1] = s->kind, r[2] = s->axis, r[3] = s->side;
+    for (int a = 0; a < 3; ++a) r[4 + a] = s->lo[a], r[7 + a] = s->hi[a];
+  }
+  const herr_t st =
+      mpmc_h5_dataset_write(f, "walls", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)nw, WALLCOLS, w);
+  free(w);
+  return st < 0 ? -1 : 0;
+}
+
+static int read_walls(hid_t f, mpmc_sim sim) {
+  mpmc_context ctx = sim->ctx;
+  hid_t ds = exists(f, "walls") ? H5Dopen2(f, "walls", H5P_DEFAULT) : -1;
+  MPMC_CHECK(ds >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /walls dataset");
+  hid_t sp = H5Dget_space(ds);
+  hsize_t dims[2] = {0, 0};
+  const int rank = sp >= 0 ? H5Sget_simple_extent_dims(sp, dims, NULL) : -1;
+  if (sp >= 0) H5Sclose(sp);
+  H5Dclose(ds);
+  MPMC_CHECK(rank == 2 && dims[1] == WALLCOLS && dims[0] < 1000000, ctx, MPMC_ERR_FORMAT,
+             "checkpoint /walls is not [n][%d]", WALLCOLS);
+  const int nw = (int)dims[0];
+  double *w = malloc(sizeof(double) * WALLCOLS * (size_t)(nw > 0 ? nw : 1));
+  sim->walls = calloc((size_t)(nw > 0 ? nw : 1), sizeof *sim->walls);
+  MPMC_CHECK(w && sim->walls, ctx, MPMC_ERR_MEMORY, "cannot allocate %d walls", nw);
+  sim->capwall = nw > 0 ? nw : 1;
+  if (read_dataset(f, "walls", H5T_NATIVE_DOUBLE, (size_t)nw, WALLCOLS, w) < 0) {
+    free(w);
+    return MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /walls: unreadable");
+  }
+  for (int i = 0; i < nw; ++i) {
+    const double *r = w + (size_t)i * WALLCOLS;
+    mpmc_wall *s = &sim->walls[i];
+    s->active = (int)r[0], s->kind = (int)r[1], s->axis = (int)r[2], s->side = (int)r[3];
+    for (int a = 0; a < 3; ++a) s->lo[a] = r[4 + a], s->hi[a] = r[7 + a];
+  }
+  free(w);
+  sim->nwall = nw;
+  sim->walls_dirty = 1;
+  return MPMC_SUCCESS;
+}
+
+/* ---- block: particle sets ------------------------------------------------------------------ */
+
+static int write_sets(hid_t f, const mpmc_sim sim) {
+  hid_t g = H5Gcreate2(f, "sets", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (g < 0) return -1;
+  const int ns = sim->sets ? sim->sets->n : 0;
+  herr_t st = mpmc_h5_attr_write(g, "count", H5T_NATIVE_INT, 1, &ns);
+  for (int k = 0; k < ns && st >= 0; ++k) {
+    const mpmc_set *s = &sim->sets->s[k];
+    char name[32];
+    snprintf(name, sizeof name, "%06d", k); /* set names may hold '/' : kept as attributes */
+    st |= mpmc_h5_dataset_write(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)s->n, 0, s->idx);
+    hid_t ds = st >= 0 ? H5Dopen2(g, name, H5P_DEFAULT) : -1;
+    if (ds < 0 || mpmc_h5_attr_write_string(ds, "name", s->name) < 0) st = -1;
+    if (ds >= 0) H5Dclose(ds);
+  }
+  H5Gclose(g);
+  return st < 0 ? -1 : 0;
+}
+
+static int read_sets(hid_t f, mpmc_sim sim) {
+  mpmc_context ctx = sim->ctx;
+  hid_t g = exists(f, "sets") ? H5Gopen2(f, "sets", H5P_DEFAULT) : -1;
+  MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /sets group");
+  int ns = -1, err = MPMC_SUCCESS;
+  if (mpmc_h5_attr_read(g, "count", H5T_NATIVE_INT, 1, &ns) < 0 || ns < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /sets: bad count %d", ns);
+  for (int k = 0; k < ns && !err; ++k) {
+    char dname[32];
+    snprintf(dname, sizeof dname, "%06d", k);
+    hid_t ds = exists(g, dname) ? H5Dopen2(g, dname, H5P_DEFAULT) : -1;
+    char *name = NULL;
+    hssize_t n = -1;
+    if (ds >= 0) {
+      hid_t sp = H5Dget_space(ds);
+      n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
+      if (sp >= 0) H5Sclose(sp);
+      if (mpmc_h5_attr_read_string(ds, "name", &name) < 0) n = -1;
+      H5Dclose(ds);
+    }
+    int *idx = n >= 0 && n < INT32_MAX ? malloc(sizeof(int) * (size_t)(n > 0 ? n : 1)) : NULL;
+    if (!idx || read_dataset(g, dname, H5T_NATIVE_INT, (size_t)n, 0, idx) < 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /sets/%s: unreadable", dname);
+    else
+      err = mpmc_sim_add_particle_set(sim, name, (int)n, idx, NULL);
+    free(idx);
+    free(name);
+  }
+  H5Gclose(g);
+  return err;
+}
+
+/* ---- the file ------------------------------------------------------------------------------ */
+
+typedef struct {
+  const char *name;
+  int (*write)(hid_t f, const mpmc_sim sim); /* < 0 on an HDF5 failure             */
+  int (*read)(hid_t f, mpmc_sim sim);        /* an MPMC error code with a message  */
+} block;
+
+/* Materials before particles (ids are checked), particles before sets (indices are). */
+static const block blocks[] = {{"config", write_config, read_config},
+                               {"materials", write_materials, read_materials},
+                               {"particles", write_particles, read_particles},
+                               {"walls", write_walls, read_walls},
+                               {"sets", write_sets, read_sets}};
+#define NBLOCK (sizeof blocks / sizeof blocks[0])
+
+/**
+ * @brief Write everything needed to continue the run to `path`, atomically: the file is
+ *        written as path.tmp, flushed, fsync'ed and renamed over path.  On failure path is
+ *        left as it was.
+ * @param meta the caller's text stored alongside (e.g. the workflow stage), may be NULL
+ */
+int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *meta) {
+  if (!sim) return MPMC_ERR_ARG;
+  mpmc_context ctx = sim->ctx;
+  MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");
+  MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "checkpoint: no grid set, nothing to save");
+  MPMC_CHECK(!sim->bodies, ctx, MPMC_ERR_UNSUPPORTED,
+             "checkpoint: rigid bodies cannot be saved yet; '%s' not written", path);
+  const size_t len = strlen(path) + 5;
+  char *tmp = malloc(len);
+  MPMC_CHECK(tmp, ctx, MPMC_ERR_MEMORY, "cannot allocate a path");
+  snprintf(tmp, len, "%s.tmp", path);
+  mpmc_h5_quiet q;
+  mpmc_h5_quiet_begin(&q);
+  int err = MPMC_SUCCESS;
+  hid_t f = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (f < 0) {
+    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot create the checkpoint file '%s'", tmp);
+  } else {
+    const int version = CKPT_VERSION;
+    herr_t st = 0;
+    st |= mpmc_h5_attr_write_string(f, "format", CKPT_FORMAT);
+    st |= mpmc_h5_attr_write(f, "format_version", H5T_NATIVE_INT, 1, &version);
+    st |= mpmc_h5_attr_write_string(f, "library_version", MPMC_VERSION_STRING);
+    st |= mpmc_h5_attr_write_string(f, "meta", meta ? meta : "");
+    if (st < 0) err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot write the header of '%s'", tmp);
+    for (size_t b = 0; b < NBLOCK && !err; ++b)
+      if (blocks[b].write(f, sim) < 0)
+        err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot write the '%s' block of '%s'", blocks[b].name,
+                         tmp);
+    if (!err && H5Fflush(f, H5F_SCOPE_GLOBAL) < 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot flush '%s'", tmp);
+    if (H5Fclose(f) < 0 && !err) err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot close '%s'", tmp);
+  }
+  mpmc_h5_quiet_end(&q);
+  if (!err && mpmc_fsync_path(tmp) != 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot fsync '%s': %s", tmp, strerror(errno));
+  if (!err && rename(tmp, path) != 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot rename '%s' to '%s': %s", tmp, path,
+                     strerror(errno));
+  if (err)
+    remove(tmp);
+  else
+    mpmc_fsync_path(path); /* the directory entry of the rename */
+  free(tmp);
+  return err;
+}
+
+static int read_file(mpmc_context ctx, const char *path, hid_t f, mpmc_sim *out, char **meta) {
+  char *fmt = NULL;
+  int version = -1, dim = 0;
+  if (mpmc_h5_attr_read_string(f, "format", &fmt) < 0 || strcmp(fmt, CKPT_FORMAT) != 0) {
+    const int err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
+                               "'%s' is an HDF5 file but not a libmpmc checkpoint (format '%s')",
+                               path, fmt ? fmt : "none");
+    free(fmt);
+    return err;
+  }
+  free(fmt);
+  MPMC_CHECK(mpmc_h5_attr_read(f, "format_version", H5T_NATIVE_INT, 1, &version) >= 0, ctx,
+             MPMC_ERR_FORMAT, "checkpoint '%s' has no format_version", path);
+  MPMC_CHECK(version == CKPT_VERSION, ctx, MPMC_ERR_FORMAT,
+             "checkpoint '%s' has format version %d; this library (%s) reads version %d", path,
+             version, MPMC_VERSION_STRING, CKPT_VERSION);
+  hid_t g = exists(f, "config") ? H5Gopen2(f, "config", H5P_DEFAULT) : -1;
+  int ints[6] = {0};
+  if (g >= 0) {
+    if (mpmc_h5_attr_read(g, "dim_basis_fbar_solver_nthreads_forcedt", H5T_NATIVE_INT, 6, ints) >= 0)
+      dim = ints[0];
+    H5Gclose(g);
+  }
+  MPMC_CHECK(dim == 2 || dim == 3, ctx, MPMC_ERR_FORMAT,
+             "checkpoint '%s': /config missing or dimension %d is not 2 or 3", path, dim);
+  mpmc_sim sim = NULL;
+  MPMC_CALL(mpmc_sim_create(ctx, dim, &sim));
+  int err = MPMC_SUCCESS;
+  for (size_t b = 0; b < NBLOCK && !err; ++b) err = blocks[b].read(f, sim);
+  char *m = NULL;
+  if (!err && meta && mpmc_h5_attr_read_string(f, "meta", &m) < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint '%s' has no meta text", path);
+  if (err) {
+    mpmc_sim_destroy(&sim);
+    free(m);
+    return err;
+  }
+  sim->prepared = 0;
+  sim->walls_dirty = 1;
+  *out = sim;
+  if (meta) *meta = m;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Create a simulation from a checkpoint written by mpmc_sim_checkpoint_write.
+ *        User materials come back without their function: re-attach it with
+ *        mpmc_sim_set_material_user_fn before stepping.
+ * @param[out] sim the new simulation (untouched on failure)
+ * @param[out] meta a copy of the caller's text (may be NULL), released with mpmc_free
+ * @return MPMC_ERR_IO for a missing or unreadable file, MPMC_ERR_FORMAT for a truncated,
+ *         foreign or incompatible one
+ */
+int mpmc_sim_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta) {
+  if (!ctx) return MPMC_ERR_ARG;
+  MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");
+  MPMC_CHECK(sim, ctx, MPMC_ERR_ARG, "sim pointer is NULL");
+  MPMC_CHECK(access(path, R_OK) == 0, ctx, MPMC_ERR_IO, "cannot read checkpoint '%s': %s", path,
+             strerror(errno));
+  mpmc_h5_quiet q;
+  mpmc_h5_quiet_begin(&q);
+  int err;
+  const htri_t is = H5Fis_hdf5(path);
+  hid_t f = is > 0 ? H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT) : -1;
+  if (is <= 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "'%s' is not an HDF5 file (foreign or truncated)", path);
+  else if (f < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "'%s' is a damaged HDF5 file (truncated?)", path);
+  else
+    err = read_file(ctx, path, f, sim, meta);
+  if (f >= 0) H5Fclose(f);
+  mpmc_h5_quiet_end(&q);
+  return err;
+}
+
+/** @brief Release memory the library handed out (e.g. the meta text of a checkpoint). */
+void mpmc_free(void *ptr) { free(ptr); }

@@ -1,0 +1,74 @@
+/* Return mapping for Hencky elasticity with von Mises (J2) plasticity and exponential
+ * softening (private; used by material_hencky_j2.c, the tests and bench/).
+ *
+ * The scalar problem (formulas.md, "Hencky-J2"): after a trial state with von Mises stress
+ * q_trial > kappa(eps_p), find the plastic multiplier dgamma > 0 with
+ *   g(dgamma) = q_trial - 3 G dgamma - kappa(eps_p + dgamma) = 0,
+ *   kappa(e)  = kappa_r + (kappa_p - kappa_r) exp(-eta e).
+ * g is concave (kappa'' > 0), g(0) > 0 and g -> -inf, so the root is unique and lies in
+ *   [(q_trial - kappa(eps_p)) / 3G, (q_trial - kappa_r) / 3G],
+ * a bracket of width (kappa(eps_p) - kappa_r) / 3G.  g' = -3G + eta (kappa_p - kappa_r)
+ * exp(-eta e) can be positive (strong softening): the residual is then non-monotone near
+ * the lower end, the "stiff" case the auto solver hands to KINSOL. */
+#ifndef MPMC_RETURN_MAP_H
+#define MPMC_RETURN_MAP_H
+
+#include "mpmc_impl.h"
+
+/* Material constants the return map needs. */
+typedef struct {
+  double K, G;                  /* bulk and shear moduli                              */
+  double kappa_p, kappa_r, eta; /* peak and residual strength (q at yield), softening  */
+} mpmc_j2_param;
+
+/* What one return map did (for statistics, tests and error messages). */
+typedef struct {
+  int plastic;       /* 1 if the trial state was outside the yield surface            */
+  int fallback;      /* 1 if the auto solver handed this point to KINSOL               */
+  int newton_iters;  /* Newton iterations (including bisection steps)                 */
+  int bisections;    /* safeguard (bisection) steps taken by the newton solver          */
+  int kinsol_iters;  /* KINSOL nonlinear iterations                                    */
+  int kinsol_flag;   /* KINSol's return value (0 when KINSOL was not called)            */
+  double q_trial;    /* trial von Mises stress                                          */
+  double kappa;      /* strength at the start of the step, kappa(eps_p^n)               */
+  double dgamma;     /* plastic multiplier = increment of eps_p                         */
+  double residual;   /* |q_new - kappa(eps_p + dgamma)| after the solve                */
+} mpmc_j2_info;
+
+/* One workspace per thread: the KINSOL memory, its vectors and its SUNContext, created
+ * on first use and reused for every later solve.  Never shared between threads. */
+typedef struct mpmc_rm_ws_s mpmc_rm_ws;
+
+int mpmc_rm_ws_create(mpmc_rm_ws **ws);
+void mpmc_rm_ws_destroy(mpmc_rm_ws **ws);
+
+/* kappa(e) and the scalar solve.  The unknown is q_new = q_trial - 3G dgamma in
+ * [kappa_r, kappa(eps_p)] (return_map.c says why).  solver: MPMC_SOLVER_*.  Returns 0,
+ * MPMC_ERR_SOLVER (no convergence or KINSOL failure: info->kinsol_flag says which),
+ * MPMC_ERR_NUMERIC (non-finite input), MPMC_ERR_ARG (q_trial <= kappa: elastic) or
+ * MPMC_ERR_MEMORY (KINSOL could not be created).  ws may be NULL for MPMC_SOLVER_NEWTON.
+ * On success *dgamma >= 0, *q_new (may be NULL) > 0 and
+ * |q_new - kappa(eps_p + dgamma)| <= mpmc_rm_tolerance(). */
+double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p);
+double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p);
+int mpmc_rm_solve(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q_trial,
+                  double eps_p, double *dgamma, double *q_new, mpmc_j2_info *info);
+
+/* The whole return map of one point (material_hencky_j2.c):
+ *   F    relative deformation gradient (3x3, F-bar scaled when on); NULL: be is already
+ *        the trial state;
+ *   be   elastic left Cauchy-Green tensor (Voigt), b_e^n in, b_e^{n+1} out;
+ *   eps_p equivalent plastic strain, in/out;
+ *   tau  Kirchhoff stress out (Voigt); the Cauchy stress is tau / J with
+ *        J = sqrt(det be) = *J_out (may be NULL).
+ * Returns 0, MPMC_ERR_NUMERIC (trial be not positive definite or not finite) or the
+ * solver's code; on failure be, eps_p and tau are left unchanged. */
+int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],
+                       double *be, double *eps_p, double *tau, double *J_out,
+                       mpmc_j2_info *info);
+
+/* The per-thread workspaces of a simulation (sim->solver_ws): makes sure there are
+ * at least nthreads and returns them; freed by mpmc_return_map_free. */
+int mpmc_rm_sim_workspaces(struct mpmc_sim_s *sim, int nthreads, mpmc_rm_ws ***ws);
+
+#endif
