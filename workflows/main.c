@@ -1,0 +1,103 @@
+/* `mpmc`: the command-line front end of the staged workflow (docs/workflows.md). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpmc.h"
+
+static const char usage[] =
+    "usage: mpmc run SCENE.yaml [--out DIR] [--set key.path=value ...] [--threads N] [--force] [--quiet]\n"
+    "       mpmc check SCENE.yaml [--set key.path=value ...]\n"
+    "       mpmc resume DIR [--quiet]\n"
+    "       mpmc --help | --version\n"
+    "\n"
+    "  run     run every stage of the scene; outputs go to DIR (default out/<scene>):\n"
+    "          summary.json, series.csv, snapshots.h5/.xdmf, checkpoint.h5, PNG plots\n"
+    "  check   validate the scene (and the --set overrides) and print what would run\n"
+    "  resume  continue a run from the last checkpoint in DIR\n"
+    "\n"
+    "  --set key.path=value  override any scene value, e.g. --set grid.cell_size=0.5\n"
+    "                        --set fbar=false --set stages.runout.end.time=2\n"
+    "                        (list items by index from 0 or by name)\n"
+    "  --threads N           OpenMP threads (the same as --set threads=N)\n"
+    "  --force               write into an existing, non-empty DIR\n"
+    "  --quiet               no log and no progress\n"
+    "\n"
+    "Exit status 0 only when every stage completed.  Scene keys: docs/workflows.md.\n";
+
+/* The library's message without its "<code>: " prefix and " [file.c:line]" suffix. */
+static void print_error(mpmc_context ctx, int code) {
+  char msg[1200];
+  snprintf(msg, sizeof msg, "%s", mpmc_context_last_error(ctx));
+  const char *pre = mpmc_error_string(code);
+  char *body = msg;
+  if (!strncmp(body, pre, strlen(pre)) && !strncmp(body + strlen(pre), ": ", 2)) body += strlen(pre) + 2;
+  char *tail = strrchr(body, '[');
+  if (tail && tail > body && tail[-1] == ' ' && strchr(tail, ']') && !strchr(tail, ' ')) tail[-1] = '\0';
+  fprintf(stderr, "mpmc: error: %s\n", body[0] ? body : mpmc_error_string(code));
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+    fputs(usage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  if (!strcmp(argv[1], "--version")) {
+    int a, b, c;
+    mpmc_version(&a, &b, &c);
+    printf("mpmc %d.%d.%d (libmpmc, F-bar MPM of Zhao, Jiang & Choo 2023)\n", a, b, c);
+    return 0;
+  }
+  const char *cmd = argv[1];
+  if (strcmp(cmd, "run") && strcmp(cmd, "check") && strcmp(cmd, "resume")) {
+    fprintf(stderr, "mpmc: unknown command '%s'\n%s", cmd, usage);
+    return 2;
+  }
+  const char *target = NULL, *out = NULL;
+  int flags = 0, nset = 0;
+  const char **sets = calloc((size_t)argc + 1, sizeof *sets);
+  char **owned = calloc((size_t)argc + 1, sizeof *owned);
+  int nowned = 0;
+  if (!sets || !owned) return 1;
+  for (int i = 2; i < argc; ++i) {
+    const char *a = argv[i];
+    if (!strcmp(a, "--out") && i + 1 < argc)
+      out = argv[++i];
+    else if (!strcmp(a, "--set") && i + 1 < argc)
+      sets[nset++] = argv[++i];
+    else if (!strncmp(a, "--set=", 6))
+      sets[nset++] = a + 6;
+    else if (!strcmp(a, "--threads") && i + 1 < argc) {
+      const size_t n = strlen(argv[i + 1]) + 16;
+      char *s = malloc(n);
+      if (!s) return 1;
+      snprintf(s, n, "threads=%s", argv[++i]);
+      sets[nset++] = owned[nowned++] = s;
+    } else if (!strcmp(a, "--force"))
+      flags |= MPMC_WORKFLOW_FORCE;
+    else if (!strcmp(a, "--quiet"))
+      flags |= MPMC_WORKFLOW_QUIET;
+    else if (a[0] == '-' || target) {
+      fprintf(stderr, "mpmc %s: unexpected argument '%s'\n%s", cmd, a, usage);
+      return 2;
+    } else
+      target = a;
+  }
+  if (!target) {
+    fprintf(stderr, "mpmc %s: missing %s\n%s", cmd, strcmp(cmd, "resume") ? "SCENE.yaml" : "DIR", usage);
+    return 2;
+  }
+  mpmc_context ctx;
+  if (mpmc_context_create(&ctx)) return 1;
+  int err;
+  if (!strcmp(cmd, "resume"))
+    err = mpmc_workflow_resume(ctx, target, flags & MPMC_WORKFLOW_QUIET);
+  else
+    err = mpmc_workflow_run(ctx, target, out, nset, sets, flags | (!strcmp(cmd, "check") ? MPMC_WORKFLOW_CHECK : 0));
+  if (err) print_error(ctx, err);
+  mpmc_context_destroy(&ctx);
+  for (int i = 0; i < nowned; ++i) free(owned[i]);
+  free(owned);
+  free(sets);
+  return err ? 1 : 0;
+}

@@ -1,0 +1,151 @@
+/* PNG plots with gnuplot, run as a child process: the final state coloured by mean stress
+ * and by equivalent plastic strain (2D: the plane; 3D: a side projection onto the plane of
+ * the run-out axis and the vertical), and the time series.  The final state is also kept
+ * as final_state.csv.  A missing gnuplot is a warning, never a failure of the run. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+#include "wf.h"
+
+typedef struct {
+  double depth;
+  int q;
+} depth_idx;
+
+static int by_depth(const void *a, const void *b) {
+  const double da = ((const depth_idx *)a)->depth, db = ((const depth_idx *)b)->depth;
+  return da < db ? 1 : da > db ? -1 : 0; /* far points first, near points drawn last */
+}
+
+/* The vertical axis: the largest gravity component of the last stage that sets gravity. */
+static int vertical_axis(const wf_scene *sc) {
+  int v = 1;
+  for (int i = 0; i < sc->nstage; ++i) {
+    if (!sc->stages[i].has_gravity) continue;
+    double best = 0;
+    for (int a = 0; a < sc->dim; ++a)
+      if (fabs(sc->stages[i].gravity[a]) > best) {
+        best = fabs(sc->stages[i].gravity[a]);
+        v = a;
+      }
+  }
+  return v;
+}
+
+static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int hx, int vy, int *has_eps) {
+  int np;
+  double *x, *x0, *sig, *eps = NULL;
+  mpmc_sim_get_num_particles(sim, &np);
+  if (mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) || mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL) ||
+      mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
+    return -1;
+  int plastic = 0;
+  for (int i = 0; i < sc->nmat; ++i) plastic |= sc->mats[i].model == WF_MODEL_HENCKY_J2;
+  if (plastic && mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
+  *has_eps = eps != NULL;
+  const int d = sc->dim;
+  depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
+  FILE *f = fopen(path, "w");
+  if (!order || !f) {
+    free(order);
+    if (f) fclose(f);
+    return -1;
+  }
+  const int dz = 3 - hx - vy; /* 3D: the axis the projection looks along */
+  for (int q = 0; q < np; ++q) {
+    order[q].q = q;
+    order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
+  }
+  if (d == 3) qsort(order, (size_t)np, sizeof *order, by_depth);
+  fprintf(f, d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz\n" : "x,y,mean_stress,eps_p,ux,uy\n");
+  for (int k = 0; k < np; ++k) {
+    const size_t q = (size_t)order[k].q;
+    const double p = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3.0;
+    for (int a = 0; a < d; ++a) fprintf(f, "%.7g,", x[q * d + a]);
+    fprintf(f, "%.7g,%.7g", p, eps ? eps[q] : 0.0);
+    for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - x0[q * d + a]);
+    fputc('\n', f);
+  }
+  free(order);
+  return fclose(f) ? -1 : 0;
+}
+
+/** @brief Write final_state.csv and the PNG plots into outdir. */
+int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *warn, size_t len) {
+  const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
+  int hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
+  if (hx == vy) hx = vy == 0 ? 1 : 0;
+  char path[WF_PATH + 32];
+  int has_eps = 0;
+  snprintf(path, sizeof path, "%s/final_state.csv", outdir);
+  if (write_state(sim, sc, path, hx, vy, &has_eps)) {
+    snprintf(warn, len, "cannot write %s", path);
+    return 1;
+  }
+  if (strpbrk(outdir, "\"'\\`$")) {
+    snprintf(warn, len, "output path has quote characters; plots skipped");
+    return 1;
+  }
+  if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    snprintf(warn, len, "gnuplot not found (Debian package gnuplot-nox): no PNG plots, the data is in final_state.csv and series.csv");
+    return 1;
+  }
+  char cmd[WF_PATH + 64];
+  snprintf(cmd, sizeof cmd, "gnuplot >'%s/plots.log' 2>&1", outdir);
+  FILE *g = popen(cmd, "w");
+  if (!g) {
+    snprintf(warn, len, "cannot start gnuplot");
+    return 1;
+  }
+  const char *ax = "xyz";
+  double t = 0;
+  mpmc_sim_get_time(sim, &t);
+  const int d = sc->dim;
+  /* columns of final_state.csv: coordinates, mean stress, eps_p */
+  const int cx = hx + 1, cy = vy + 1, cp = d + 1, ce = d + 2;
+  fprintf(g, "cd \"%s\"\nset datafile separator ','\n", outdir);
+  fprintf(g, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1400,700 font ',12' } "
+             "else { set terminal png size 1400,700 }\n");
+  fprintf(g, "set size ratio -1\nset xlabel '%c [m]'\nset ylabel '%c [m]'\nset grid\n", ax[hx], ax[vy]);
+  fprintf(g, "set palette defined (0 '#313695', 1 '#4575b4', 2 '#74add1', 3 '#abd9e9', 4 '#fee090', "
+             "5 '#fdae61', 6 '#f46d43', 7 '#d73027', 8 '#a50026')\n");
+  fprintf(g, "set output 'final_mean_stress.png'\n");
+  fprintf(g, "set title '%s%s: mean stress p = tr(sigma)/3 [kPa] at t = %.3f s (tension > 0)' noenhanced\n", sc->name,
+          d == 3 ? " (side view)" : "", t);
+  fprintf(g, "set cblabel 'p [kPa]'\n");
+  fprintf(g, "plot 'final_state.csv' skip 1 using %d:%d:($%d/1000) with points pt 7 ps 0.35 lc palette notitle\n",
+          cx, cy, cp);
+  if (has_eps) {
+    fprintf(g, "set output 'final_eps_p.png'\n");
+    fprintf(g, "set title '%s%s: equivalent plastic strain at t = %.3f s' noenhanced\nset cblabel 'eps_p' noenhanced\nset cbrange [0:*]\n",
+            sc->name, d == 3 ? " (side view)" : "", t);
+    fprintf(g, "plot 'final_state.csv' skip 1 using %d:%d:%d with points pt 7 ps 0.35 lc palette notitle\n", cx, cy,
+            ce);
+    fprintf(g, "set cbrange [*:*]\n");
+  }
+  /* time series: kinetic energy and the scene's metrics */
+  fprintf(g, "unset size\nset size noratio\nset output 'series.png'\nset multiplot layout 2,1 title '%s: time series' noenhanced\n",
+          sc->name);
+  fprintf(g, "set xlabel 'time [s]'\nset ylabel 'kinetic energy [J%s]'\nset logscale y\nset title ''\n",
+          d == 2 ? "/m" : "");
+  fprintf(g, "plot 'series.csv' skip 1 using 2:($5 > 0 ? $5 : NaN) with lines lw 2 title 'E_k'\n");
+  fprintf(g, "unset logscale y\n");
+  int col = 7, any = 0;
+  for (int k = 0; k < WF_METRIC_COUNT; ++k) {
+    if (!sc->metrics.enabled[k]) continue;
+    fprintf(g, "%s 'series.csv' skip 1 using 2:%d with lines lw 2 title '%s'", any ? "," : "set ylabel 'metric [m]'\nset key noenhanced\nplot",
+            col++, wf_metric_names[k]);
+    any = 1;
+  }
+  if (!any) fprintf(g, "plot 'series.csv' skip 1 using 2:6 with lines lw 2 title 'E_k / E_k,max'");
+  fprintf(g, "\nunset multiplot\n");
+  const int st = pclose(g);
+  if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+    snprintf(warn, len, "gnuplot failed (see %s/plots.log)", outdir);
+    return 1;
+  }
+  return 0;
+}

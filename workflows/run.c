@@ -1,0 +1,754 @@
+/* mpmc_workflow_run: build the simulation a scene describes and run its stages, writing
+ * the outputs (series.csv, snapshots, checkpoints, summary.json, plots) into one directory.
+ * Only what the scene needs is switched on: no plastic state without a plastic material,
+ * no F-bar pass when off, no gmsh library unless a body is seeded from gmsh. */
+#define _XOPEN_SOURCE 700 /* realpath */
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "mpmc_impl.h"
+#include "wf.h"
+
+double wf_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct {
+  char name[WF_NAME];
+  double sim_time, wall_seconds;
+  long steps;
+  const char *reason;
+} stage_record;
+
+typedef struct {
+  mpmc_context ctx;
+  wf_scene sc;
+  mpmc_sim sim;
+  char out[WF_PATH];
+  int quiet, check;
+  FILE *series;
+  mpmc_output snap;
+  stage_record *rec;
+  int *wall_ids;           /* per stage and wall, flattened                              */
+  int nwall_ids;
+  double t_start;
+  char status_msg[WF_MSG];
+  int noverride;
+  const char *const *overrides;
+  double strength;         /* the strength reduction factor in force (1: as given)        */
+  int saved_threads;       /* OpenMP threads before the run (0: unchanged)                 */
+} wf_run;
+
+/* `threads` applies to every parallel region of the run (the step and the reductions the
+ * workflow calls between steps), not only to mpmc_sim_step: on a busy machine a single
+ * region with more threads than free cores costs more than the whole step. */
+static void set_threads(wf_run *w) {
+#ifdef _OPENMP
+  if (w->sc.threads > 0) {
+    w->saved_threads = omp_get_max_threads();
+    omp_set_num_threads(w->sc.threads);
+  }
+#else
+  (void)w;
+#endif
+}
+
+static void say(const wf_run *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void say(const wf_run *w, const char *fmt, ...) {
+  if (w->quiet) return;
+  va_list ap;
+  va_start(ap, fmt);
+  fputs("mpmc: ", stdout);
+  vfprintf(stdout, fmt, ap);
+  fputc('\n', stdout);
+  va_end(ap);
+  fflush(stdout);
+}
+
+/* Record msg in the context (the caller reads it with mpmc_context_last_error). */
+static int fail(wf_run *w, int code, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static int fail(wf_run *w, int code, const char *fmt, ...) {
+  char body[WF_MSG];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(body, sizeof body, fmt, ap);
+  va_end(ap);
+  snprintf(w->status_msg, sizeof w->status_msg, "%s", body);
+  return MPMC_ERROR(w->ctx, code, "%s", body);
+}
+
+/* Wrap a library call: on failure keep the library's message and add what we were doing. */
+#define WF_TRY(w, expr, ...)                                                      \
+  do {                                                                            \
+    int wf_e_ = (expr);                                                           \
+    if (wf_e_) {                                                                  \
+      char wf_what_[256];                                                         \
+      snprintf(wf_what_, sizeof wf_what_, __VA_ARGS__);                           \
+      return fail((w), wf_e_, "%s: %s", wf_what_, mpmc_context_last_error((w)->ctx)); \
+    }                                                                             \
+  } while (0)
+
+static int mkdir_p(const char *path) {
+  char tmp[WF_PATH];
+  snprintf(tmp, sizeof tmp, "%s", path);
+  for (char *p = tmp + 1; *p; ++p) {
+    if (*p != '/') continue;
+    *p = '\0';
+    if (mkdir(tmp, 0777) && errno != EEXIST) return -1;
+    *p = '/';
+  }
+  if (mkdir(tmp, 0777) && errno != EEXIST) return -1;
+  return 0;
+}
+
+/* 1: exists and holds entries, 0: absent or empty, -1: not a directory */
+static int dir_nonempty(const char *path) {
+  struct stat s;
+  if (stat(path, &s)) return 0;
+  if (!S_ISDIR(s.st_mode)) return -1;
+  DIR *d = opendir(path);
+  if (!d) return -1;
+  int any = 0;
+  struct dirent *e;
+  while ((e = readdir(d)))
+    if (strcmp(e->d_name, ".") && strcmp(e->d_name, "..")) {
+      any = 1;
+      break;
+    }
+  closedir(d);
+  return any;
+}
+
+static void out_path(const wf_run *w, const char *name, char *buf, size_t len) {
+  snprintf(buf, len, "%s/%s", w->out, name);
+}
+
+/* ---- set-up ---------------------------------------------------------------------------- */
+static int build(wf_run *w) {
+  wf_scene *sc = &w->sc;
+  WF_TRY(w, mpmc_sim_create(w->ctx, sc->dim, &w->sim), "creating the simulation");
+  mpmc_sim sim = w->sim;
+  WF_TRY(w, mpmc_sim_set_grid(sim, sc->lo, sc->hi, sc->h), "grid");
+  WF_TRY(w, mpmc_sim_set_basis(sim, sc->basis), "basis");
+  WF_TRY(w, mpmc_sim_set_fbar(sim, sc->fbar), "fbar");
+  WF_TRY(w, mpmc_sim_set_flip_blend(sim, sc->flip), "flip");
+  WF_TRY(w, mpmc_sim_set_solver(sim, sc->solver), "solver");
+  WF_TRY(w, mpmc_sim_set_threads(sim, sc->threads), "threads");
+  for (int i = 0; i < sc->nmat; ++i) {
+    wf_material *m = &sc->mats[i];
+    int e = 0;
+    switch (m->model) {
+      case WF_MODEL_HENCKY_J2:
+        e = mpmc_sim_add_material_hencky_j2(sim, m->E, m->nu, m->rho, m->kappa_p, m->kappa_r, m->eta, &m->id);
+        break;
+      case WF_MODEL_HENCKY: e = mpmc_sim_add_material_hencky(sim, m->E, m->nu, m->rho, &m->id); break;
+      case WF_MODEL_NEO_HOOKEAN: e = mpmc_sim_add_material_neo_hookean(sim, m->E, m->nu, m->rho, &m->id); break;
+      default: e = mpmc_sim_add_material_newtonian(sim, m->K, m->mu, m->rho, &m->id); break;
+    }
+    WF_TRY(w, e, "materials.%s", m->name);
+  }
+  for (int i = 0; i < sc->nbody; ++i) {
+    const wf_body *b = &sc->bodies[i];
+    const int mat = sc->mats[b->material].id;
+    int first = 0, count = 0;
+    if (b->type == WF_GEOM_BOX) {
+      WF_TRY(w, mpmc_sim_seed_box(sim, b->lo, b->hi, b->ppc, mat, &first, &count), "geometry.%d (box)", i);
+    } else if (b->type == WF_GEOM_POLYGON) {
+      WF_TRY(w, mpmc_sim_seed_polygon(sim, b->nvert, b->xy, b->ppc, mat, &first, &count),
+             "geometry.%d (polygon)", i);
+    } else {
+      char msg[WF_MSG];
+      const int e = wf_seed_gmsh(sim, b->file, b->region, b->mode, b->ppc, mat, &first, &count, msg, sizeof msg);
+      if (e) return fail(w, e, "geometry.%d (gmsh %s): %s", i, b->file, msg);
+    }
+    if (count == 0) return fail(w, MPMC_ERR_ARG, "geometry.%d: no material point inside (check the grid and the shape)", i);
+    int nonzero = 0;
+    for (int a = 0; a < sc->dim; ++a) nonzero |= b->velocity[a] != 0.0;
+    if (nonzero) {
+      double *v;
+      WF_TRY(w, mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL), "velocity");
+      for (int q = first; q < first + count; ++q)
+        for (int a = 0; a < sc->dim; ++a) v[(size_t)q * sc->dim + a] = b->velocity[a];
+      mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v);
+    }
+  }
+  WF_TRY(w, wf_metrics_init(sim, sc), "metrics");
+  return 0;
+}
+
+static void log_plan(const wf_run *w) {
+  const wf_scene *sc = &w->sc;
+  int np = 0, plastic = 0, gmsh = 0, damping = 0, tractions = 0, walls = 0, srf = 0;
+  if (w->sim) mpmc_sim_get_num_particles(w->sim, &np);
+  for (int i = 0; i < sc->nmat; ++i) plastic |= sc->mats[i].model == WF_MODEL_HENCKY_J2;
+  for (int i = 0; i < sc->nbody; ++i) gmsh |= sc->bodies[i].type == WF_GEOM_GMSH;
+  for (int i = 0; i < sc->nstage; ++i) {
+    damping |= sc->stages[i].damping > 0;
+    tractions |= sc->stages[i].ntractions > 0;
+    walls += sc->stages[i].nwalls;
+    srf |= sc->stages[i].strength_reduction > 0;
+  }
+  say(w, "scene %s (%s): %dD%s, grid %g m cells, basis %s, %d material points", sc->name, sc->path,
+      sc->dim, sc->dim == 2 ? " plane strain" : "", sc->h, wf_basis_name(sc->basis), np);
+  char on[512] = "", off[512] = "";
+#define FEATURE(cond, text)                                             \
+  do {                                                                  \
+    char *buf_ = (cond) ? on : off;                                     \
+    const size_t l_ = strlen(buf_);                                     \
+    snprintf(buf_ + l_, sizeof on - l_, "%s%s", l_ ? ", " : "", text); \
+  } while (0)
+  FEATURE(sc->fbar, "F-bar");
+  FEATURE(plastic, "plastic state (hencky_j2)");
+  FEATURE(gmsh, "gmsh seeding");
+  FEATURE(damping, "local damping");
+  FEATURE(walls > 0, "walls");
+  FEATURE(tractions, "tractions");
+  FEATURE(srf, "strength reduction");
+  FEATURE(0, "rigid-body contact");
+#ifdef MPMC_WF_HAVE_CHECKPOINT
+  FEATURE(1, "checkpoints");
+#else
+  FEATURE(0, "checkpoints (not in this build)");
+#endif
+#undef FEATURE
+  say(w, "enabled: %s", on[0] ? on : "nothing optional");
+  say(w, "left out: %s", off[0] ? off : "nothing");
+  for (int i = 0; i < sc->nmat; ++i) {
+    const wf_material *m = &sc->mats[i];
+    if (m->model == WF_MODEL_HENCKY_J2)
+      say(w, "material %s: hencky_j2 E = %g Pa, nu = %g, rho = %g kg/m^3, kappa_p = %g Pa, kappa_r = %g Pa, eta = %g",
+          m->name, m->E, m->nu, m->rho, m->kappa_p, m->kappa_r, m->eta);
+    else if (m->model == WF_MODEL_NEWTONIAN)
+      say(w, "material %s: newtonian K = %g Pa, mu = %g Pa s, rho = %g kg/m^3", m->name, m->K, m->mu, m->rho);
+    else
+      say(w, "material %s: %s E = %g Pa, nu = %g, rho = %g kg/m^3", m->name, wf_model_name(m->model), m->E,
+          m->nu, m->rho);
+  }
+  for (int i = 0; i < sc->nstage; ++i) {
+    const wf_stage *s = &sc->stages[i];
+    char end[128];
+    if (s->end_kind == WF_END_TIME)
+      snprintf(end, sizeof end, "for %g s", s->end_time);
+    else
+      snprintf(end, sizeof end, "until E_k/E_k,max < %g (at most %g s)", s->ke_ratio, s->max_time);
+    char extra[256] = "";
+    if (s->strength_reduction > 0)
+      snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", strength = material's / %g",
+               s->strength_reduction);
+    if (s->damping > 0) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", damping %g", s->damping);
+    if (s->nwalls) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", +%d walls", s->nwalls);
+    if (s->nremove) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", -%d walls", s->nremove);
+    say(w, "stage %d/%d %s: %s%s", i + 1, sc->nstage, s->name, end, extra);
+  }
+}
+
+/* Walls, gravity, damping, tractions and strength changes at the start of stage i. */
+static int stage_setup(wf_run *w, int i) {
+  const wf_scene *sc = &w->sc;
+  const wf_stage *s = &sc->stages[i];
+  mpmc_sim sim = w->sim;
+  if (s->has_gravity) WF_TRY(w, mpmc_sim_set_gravity(sim, s->gravity), "stages.%d.gravity", i);
+  WF_TRY(w, mpmc_sim_set_damping(sim, s->damping), "stages.%d.damping", i);
+  int base = 0;
+  for (int j = 0; j < i; ++j) base += sc->stages[j].nwalls;
+  for (int k = 0; k < s->nwalls; ++k) {
+    const wf_wall *wl = &s->walls[k];
+    int id = -1;
+    if (wl->form == 0)
+      WF_TRY(w, mpmc_sim_add_wall_face(sim, wl->face, wl->kind, &id), "stages.%d.walls.%d", i, k);
+    else if (wl->form == 1)
+      WF_TRY(w, mpmc_sim_add_wall(sim, wl->axis, wl->side, wl->position, wl->kind, &id), "stages.%d.walls.%d", i, k);
+    else
+      WF_TRY(w, mpmc_sim_add_wall_box(sim, wl->lo, wl->hi, wl->kind, wl->axis, wl->side, &id),
+             "stages.%d.walls.%d", i, k);
+    w->wall_ids[base + k] = id;
+  }
+  for (int k = 0; k < s->nremove; ++k) {
+    int b = 0;
+    for (int j = 0; j < i; ++j) {
+      for (int m = 0; m < sc->stages[j].nwalls; ++m)
+        if (!strcmp(sc->stages[j].walls[m].name, s->remove[k]) && w->wall_ids[b + m] >= 0) {
+          WF_TRY(w, mpmc_sim_remove_wall(sim, w->wall_ids[b + m]), "stages.%d.remove_walls.%d", i, k);
+          w->wall_ids[b + m] = -1;
+        }
+      b += sc->stages[j].nwalls;
+    }
+  }
+  if (s->ntractions) {
+    int np;
+    mpmc_sim_get_num_particles(sim, &np);
+    const int d = sc->dim;
+    double *f = calloc((size_t)np * d + 1, sizeof *f), *x, *vol0;
+    if (!f) return fail(w, MPMC_ERR_MEMORY, "stages.%d.tractions: out of memory", i);
+    int e = mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x, NULL);
+    if (!e) e = mpmc_sim_get_field(sim, MPMC_FIELD_VOLUME0, &vol0, NULL);
+    for (int k = 0; k < s->ntractions && !e; ++k) {
+      const wf_traction *t = &s->tractions[k];
+      /* force = traction x tributary length (2D: V^(1/2)) or area (3D: V^(2/3)) */
+      const double expo = (d - 1.0) / d;
+      int hits = 0;
+      if (t->set[0]) {
+        int id, n;
+        const int *idx;
+        const char *nm;
+        e = mpmc_sim_find_particle_set(sim, t->set, &id);
+        if (!e) e = mpmc_sim_get_particle_set(sim, id, &nm, &n, &idx);
+        for (int j = 0; !e && j < n; ++j, ++hits)
+          for (int a = 0; a < d; ++a) f[(size_t)idx[j] * d + a] += t->traction[a] * pow(vol0[idx[j]], expo);
+      } else {
+        for (int q = 0; q < np; ++q) {
+          int in = 1;
+          for (int a = 0; a < d; ++a) in &= x[(size_t)q * d + a] >= t->lo[a] && x[(size_t)q * d + a] <= t->hi[a];
+          if (!in) continue;
+          ++hits;
+          for (int a = 0; a < d; ++a) f[(size_t)q * d + a] += t->traction[a] * pow(vol0[q], expo);
+        }
+      }
+      if (!e && hits == 0) {
+        free(f);
+        return fail(w, MPMC_ERR_ARG, "stages.%d.tractions.%d: no material point in the set or region", i, k);
+      }
+    }
+    if (!e) e = mpmc_sim_set_particle_forces(sim, 0, np, f);
+    free(f);
+    WF_TRY(w, e, "stages.%d.tractions", i);
+  }
+  if (s->strength_reduction > 0 && s->strength_reduction != w->strength) {
+    /* the factor is absolute: divide by its ratio to the one in force */
+    WF_TRY(w, mpmc_sim_reduce_strength(sim, -1, s->strength_reduction / w->strength),
+           "stages.%d.strength_reduction", i);
+    w->strength = s->strength_reduction;
+  }
+  if (s->reset_velocity) {
+    double *v;
+    int np;
+    mpmc_sim_get_num_particles(sim, &np);
+    WF_TRY(w, mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL), "reset_velocity");
+    memset(v, 0, sizeof *v * (size_t)np * sc->dim);
+    mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v);
+  }
+  return 0;
+}
+
+static int series_row(wf_run *w, int stage, long step, double dt, double ke, double ratio) {
+  double t, m[WF_METRIC_COUNT];
+  mpmc_sim_get_time(w->sim, &t);
+  WF_TRY(w, wf_metrics_compute(w->sim, &w->sc, m), "metrics");
+  fprintf(w->series, "%s,%.9g,%ld,%.6g,%.9g,%.6g", w->sc.stages[stage].name, t, step, dt, ke, ratio);
+  for (int k = 0; k < WF_METRIC_COUNT; ++k)
+    if (w->sc.metrics.enabled[k]) fprintf(w->series, ",%.9g", m[k]);
+  fputc('\n', w->series);
+  fflush(w->series);
+  return 0;
+}
+
+static int snapshot(wf_run *w) {
+  if (!w->snap) return 0;
+  WF_TRY(w, mpmc_output_write(w->snap), "snapshot");
+  return 0;
+}
+
+#ifdef MPMC_WF_HAVE_CHECKPOINT
+static int checkpoint(wf_run *w, int stage, double t_stage, long steps, double ke_max, int setup_done) {
+  char path[WF_PATH], meta[16384], scene[WF_PATH];
+  out_path(w, "checkpoint.h5", path, sizeof path);
+  /* the absolute path, so that `mpmc resume` works from any directory */
+  if (!realpath(w->sc.path, scene)) snprintf(scene, sizeof scene, "%s", w->sc.path);
+  size_t l = (size_t)snprintf(meta, sizeof meta, "mpmc-workflow 1\nscene %s\nstage %d\nsetup %d\nstage_time %.17g\n"
+                              "stage_steps %ld\nke_max %.17g\nstrength %.17g\n", scene, stage, setup_done, t_stage, steps,
+                              ke_max, w->strength);
+  for (int i = 0; i < w->noverride && l < sizeof meta; ++i)
+    l += (size_t)snprintf(meta + l, sizeof meta - l, "set %s\n", w->overrides[i]);
+  for (int i = 0; i < w->nwall_ids && l < sizeof meta; ++i)
+    l += (size_t)snprintf(meta + l, sizeof meta - l, "wall %d\n", w->wall_ids[i]);
+  for (int i = 0; i < stage && l < sizeof meta; ++i)
+    l += (size_t)snprintf(meta + l, sizeof meta - l, "done %.17g %ld %.17g %s\n", w->rec[i].sim_time,
+                          w->rec[i].steps, w->rec[i].wall_seconds, w->rec[i].reason);
+  if (l >= sizeof meta) return fail(w, MPMC_ERR_MEMORY, "checkpoint: too many overrides to record");
+  WF_TRY(w, mpmc_sim_checkpoint_write(w->sim, path, meta), "checkpoint %s", path);
+  return 0;
+}
+#endif
+
+/* Run stage i from t_stage (0 unless resuming). */
+static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_max, wf_progress *pr) {
+  long steps = *nsteps;
+  const wf_scene *sc = &w->sc;
+  const wf_stage *s = &sc->stages[i];
+  mpmc_sim sim = w->sim;
+  stage_record *rec = &w->rec[i];
+  snprintf(rec->name, sizeof rec->name, "%s", s->name);
+  const double T = s->end_time; /* quasi-static: the maximum time */
+  const double w0 = wf_now();
+  double last_ckpt = w0, dt = s->dt, ke = 0.0, ratio = 1.0, t0;
+  mpmc_sim_get_time(sim, &t0);
+  t0 -= t_stage;
+  const double every_series = T / s->series_points;
+  const double every_snap = s->snapshots > 0 ? T / (s->snapshots + 1) : INFINITY;
+  double next_series = every_series * floor(t_stage / every_series + 1e-9);
+  double next_snap = every_snap * (floor(t_stage / every_snap + 1e-9) + 1);
+  const char *reason = NULL;
+  long s0 = steps;
+  (void)last_ckpt;
+  while (!reason) {
+    if (s->dt <= 0 && (steps - s0) % 10 == 0)
+      WF_TRY(w, mpmc_sim_stable_dt(sim, s->dt_factor, &dt), "stages.%d: time step", i);
+    double h = dt;
+    if (t_stage + h > T) h = T - t_stage; /* land on the stage's end */
+    const int e = mpmc_sim_step(sim, h);
+    if (e) {
+      const double tt = t0 + t_stage;
+      return fail(w, e, "stage '%s' at t = %.6g s (step %ld): %s", s->name, tt, steps, mpmc_context_last_error(w->ctx));
+    }
+    t_stage += h;
+    ++steps;
+    const int at_end = t_stage >= T * (1 - 1e-9); /* not a sliver of a step for round-off */
+    if (s->end_kind == WF_END_QUASI_STATIC) {
+      /* quasi-static when the kinetic energy has fallen to ke_ratio of its stage maximum */
+      if ((steps - s0) % 10 == 1 || at_end) { /* an O(n) reduction: not every step */
+        mpmc_sim_get_kinetic_energy(sim, &ke);
+        if (ke > ke_max) ke_max = ke;
+        ratio = ke_max > 0 ? ke / ke_max : 0.0;
+        if (ratio <= s->ke_ratio && t_stage >= s->min_time && steps - s0 > 1) reason = "quasi_static";
+      }
+    }
+    if (!reason && at_end) reason = s->end_kind == WF_END_TIME ? "time" : "max_time";
+    if (t_stage >= next_series || reason) {
+      if (s->end_kind == WF_END_TIME) mpmc_sim_get_kinetic_energy(sim, &ke);
+      if (s->end_kind == WF_END_TIME) {
+        if (ke > ke_max) ke_max = ke;
+        ratio = ke_max > 0 ? ke / ke_max : 0.0;
+      }
+      if (series_row(w, i, steps, h, ke, ratio)) return -1;
+      while (next_series <= t_stage) next_series += every_series;
+    }
+    if (t_stage >= next_snap && !reason) {
+      if (snapshot(w)) return -1;
+      while (next_snap <= t_stage) next_snap += every_snap;
+    }
+    const double now = wf_now();
+    const double rate = (double)(steps - s0) / fmax(now - w0, 1e-9);
+    if (!w->quiet) wf_progress_update(pr, sc, i, t_stage, T, steps, rate, sc->progress_interval, reason != NULL);
+#ifdef MPMC_WF_HAVE_CHECKPOINT
+    if (!reason && now - last_ckpt > sc->checkpoint_interval) {
+      if (checkpoint(w, i, t_stage, steps, ke_max, 1)) return -1;
+      last_ckpt = now;
+    }
+#endif
+  }
+  if (!w->quiet) wf_progress_done(pr);
+  rec->sim_time = t_stage;
+  rec->steps = steps;
+  for (int j = 0; j < i; ++j) rec->steps -= w->rec[j].steps; /* this stage's own steps */
+  *nsteps = steps;
+  rec->wall_seconds += wf_now() - w0;
+  rec->reason = reason;
+  if (snapshot(w)) return -1;
+  if (!strcmp(reason, "max_time"))
+    say(w, "warning: stage %s reached max_time %g s before E_k/E_k,max fell below %g (last %.3g)", s->name,
+        s->max_time, s->ke_ratio, ratio);
+  say(w, "stage %d/%d %s done: %.4g s simulated in %ld steps, %.1f s wall (%s)", i + 1, sc->nstage, s->name,
+      t_stage, rec->steps, rec->wall_seconds, reason);
+  return 0;
+}
+
+static void json_str(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; ++s) {
+    if (*s == '"' || *s == '\\')
+      fprintf(f, "\\%c", *s);
+    else if ((unsigned char)*s < 0x20)
+      fprintf(f, "\\u%04x", *s);
+    else
+      fputc(*s, f);
+  }
+  fputc('"', f);
+}
+
+static double jnum(double v) { return isfinite(v) ? v : 0.0; }
+
+static void write_summary(wf_run *w, int ok, int nstages_done) {
+  char path[WF_PATH];
+  out_path(w, "summary.json", path, sizeof path);
+  FILE *f = fopen(path, "w");
+  if (!f) return;
+  mpmc_stats st = {0};
+  int np = 0;
+  if (w->sim) {
+    mpmc_sim_get_stats(w->sim, &st);
+    mpmc_sim_get_num_particles(w->sim, &np);
+  }
+  const double wall = wf_now() - w->t_start;
+  fputs("{\n  \"scene\": ", f);
+  json_str(f, w->sc.name);
+  fputs(",\n  \"scene_file\": ", f);
+  json_str(f, w->sc.path);
+  fprintf(f, ",\n  \"status\": \"%s\",\n", ok ? "completed" : "failed");
+  if (!ok) {
+    fputs("  \"error\": ", f);
+    json_str(f, w->status_msg);
+    fputs(",\n", f);
+  }
+  fprintf(f, "  \"dim\": %d,\n  \"basis\": \"%s\",\n  \"fbar\": %s,\n  \"cell_size\": %.9g,\n", w->sc.dim,
+          wf_basis_name(w->sc.basis), w->sc.fbar == MPMC_FBAR_TOTAL ? "\"total\"" : w->sc.fbar ? "true" : "false", w->sc.h);
+  fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
+  fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
+          st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);
+  fputs("  \"stages\": [", f);
+  for (int i = 0; i < nstages_done; ++i) {
+    const stage_record *r = &w->rec[i];
+    fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
+    json_str(f, r->name);
+    fprintf(f, ", \"sim_time\": %.9g, \"steps\": %ld, \"wall_seconds\": %.6g, \"end\": \"%s\"}", r->sim_time,
+            r->steps, r->wall_seconds, r->reason ? r->reason : "failed");
+  }
+  fputs(nstages_done ? "\n  ]" : "]", f);
+  double m[WF_METRIC_COUNT] = {0};
+  if (w->sim && np > 0 && wf_metrics_compute(w->sim, &w->sc, m) == 0)
+    for (int k = 0; k < WF_METRIC_COUNT; ++k)
+      if (w->sc.metrics.enabled[k]) fprintf(f, ",\n  \"%s\": %.9g", wf_metric_names[k], jnum(m[k]));
+  fputs("\n}\n", f);
+  fclose(f);
+}
+
+static int open_outputs(wf_run *w, int append) {
+  char path[WF_PATH], xpath[WF_PATH];
+  out_path(w, "series.csv", path, sizeof path);
+  w->series = fopen(path, append ? "a" : "w");
+  if (!w->series) return fail(w, MPMC_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+  if (!append) {
+    fputs("stage,time,step,dt,kinetic_energy,ke_ratio", w->series);
+    for (int k = 0; k < WF_METRIC_COUNT; ++k)
+      if (w->sc.metrics.enabled[k]) fprintf(w->series, ",%s", wf_metric_names[k]);
+    fputc('\n', w->series);
+  }
+  out_path(w, append ? "snapshots_resumed.h5" : "snapshots.h5", path, sizeof path);
+  out_path(w, append ? "snapshots_resumed.xdmf" : "snapshots.xdmf", xpath, sizeof xpath);
+  WF_TRY(w, mpmc_output_create(w->sim, path, xpath, &w->snap), "snapshots %s", path);
+  return 0;
+}
+
+static int run_all(wf_run *w, int first_stage, double t_stage, long steps, double ke_max, int setup_done) {
+  wf_progress pr;
+  wf_progress_init(&pr);
+  if (first_stage == 0 && t_stage == 0 && snapshot(w)) return -1;
+  for (int i = first_stage; i < w->sc.nstage; ++i) {
+    if (!(i == first_stage && setup_done) && stage_setup(w, i)) return -1;
+    if (i == first_stage && t_stage == 0 && series_row(w, i, steps, 0, 0, 1)) return -1;
+    if (run_stage(w, i, i == first_stage ? t_stage : 0, &steps, i == first_stage ? ke_max : 0, &pr)) return -1;
+#ifdef MPMC_WF_HAVE_CHECKPOINT
+    if (i + 1 < w->sc.nstage && checkpoint(w, i + 1, 0, steps, 0, 0)) return -1;
+#endif
+  }
+  return 0;
+}
+
+static int finish(wf_run *w, int err) {
+  int done = 0;
+  while (done < w->sc.nstage && w->rec && w->rec[done].reason) ++done;
+  if (!w->check && w->out[0]) {
+    write_summary(w, err == 0, done);
+    if (err == 0 && w->sc.plots && w->sim) {
+      char warn[WF_MSG] = "";
+      if (wf_plots_write(w->sim, &w->sc, w->out, warn, sizeof warn)) say(w, "warning: plots: %s", warn);
+    }
+    if (err == 0) {
+      char path[WF_PATH];
+      out_path(w, "summary.json", path, sizeof path);
+      say(w, "done in %.1f s: %s", wf_now() - w->t_start, path);
+    }
+  }
+  if (w->series) fclose(w->series);
+#ifdef _OPENMP
+  if (w->saved_threads > 0) omp_set_num_threads(w->saved_threads);
+#endif
+  mpmc_output_destroy(&w->snap);
+  mpmc_sim_destroy(&w->sim);
+  free(w->rec);
+  free(w->wall_ids);
+  wf_scene_free(&w->sc);
+  return err;
+}
+
+static int prepare(wf_run *w, const char *scene, int noverride, const char *const *overrides) {
+  char msg[WF_MSG];
+  const int e = wf_scene_load(scene, noverride, overrides, &w->sc, msg, sizeof msg);
+  if (e) return fail(w, e, "%s", msg);
+  w->rec = calloc((size_t)w->sc.nstage, sizeof *w->rec);
+  for (int i = 0; i < w->sc.nstage; ++i) w->nwall_ids += w->sc.stages[i].nwalls;
+  w->wall_ids = malloc(sizeof(int) * (size_t)(w->nwall_ids + 1));
+  if (!w->rec || !w->wall_ids) return fail(w, MPMC_ERR_MEMORY, "out of memory");
+  for (int i = 0; i < w->nwall_ids; ++i) w->wall_ids[i] = -1;
+  return 0;
+}
+
+/**
+ * @brief Run a YAML scene (the `mpmc run` command).
+ * @param scene the scene file
+ * @param outdir output directory (NULL: out/<scene name>); refused when it exists and is
+ *        not empty unless flags has MPMC_WORKFLOW_FORCE
+ * @param noverride,overrides "key.path=value" strings applied over the scene
+ * @param flags MPMC_WORKFLOW_FORCE | MPMC_WORKFLOW_QUIET | MPMC_WORKFLOW_CHECK
+ * @return 0 when every stage completed; the message is in mpmc_context_last_error
+ */
+int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, int noverride,
+                      const char *const *overrides, int flags) {
+  if (!ctx) return MPMC_ERR_ARG;
+  MPMC_CHECK(scene && scene[0], ctx, MPMC_ERR_ARG, "scene file name is NULL or empty");
+  MPMC_CHECK(noverride >= 0 && (noverride == 0 || overrides), ctx, MPMC_ERR_ARG,
+             "noverride = %d with overrides = NULL", noverride);
+  MPMC_CHECK(flags >= 0 && flags < 8, ctx, MPMC_ERR_ARG, "flags = %d: unknown bits", flags);
+  wf_run w = {0};
+  w.ctx = ctx;
+  w.quiet = (flags & MPMC_WORKFLOW_QUIET) != 0;
+  w.check = (flags & MPMC_WORKFLOW_CHECK) != 0;
+  w.t_start = wf_now();
+  w.strength = 1.0;
+  w.noverride = noverride;
+  w.overrides = overrides;
+  if (prepare(&w, scene, noverride, overrides)) return finish(&w, mpmc_context_last_error(ctx)[0] ? ctx->last_code : MPMC_ERR_ARG);
+  if (outdir && outdir[0])
+    snprintf(w.out, sizeof w.out, "%s", outdir);
+  else
+    snprintf(w.out, sizeof w.out, "out/%s", w.sc.name);
+  if (!w.check) {
+    const int ne = dir_nonempty(w.out);
+    if (ne < 0) return finish(&w, fail(&w, MPMC_ERR_IO, "output '%s' is not a directory", w.out));
+    if (ne > 0 && !(flags & MPMC_WORKFLOW_FORCE)) {
+      w.out[0] = '\0';
+      return finish(&w, fail(&w, MPMC_ERR_IO, "output directory '%s' exists and is not empty: "
+                                              "nothing written (use --force to write over it)",
+                             outdir && outdir[0] ? outdir : "out/<scene>"));
+    }
+  }
+  /* build the simulation before touching the output directory: a scene that cannot be
+   * built writes nothing */
+  char out_saved[WF_PATH];
+  snprintf(out_saved, sizeof out_saved, "%s", w.out);
+  w.out[0] = '\0';
+  set_threads(&w);
+  if (build(&w)) return finish(&w, ctx->last_code);
+  snprintf(w.out, sizeof w.out, "%s", out_saved);
+  log_plan(&w);
+  if (w.check) {
+    say(&w, "check: %s is valid", scene);
+    return finish(&w, 0);
+  }
+  if (mkdir_p(w.out)) return finish(&w, fail(&w, MPMC_ERR_IO, "cannot create '%s': %s", w.out, strerror(errno)));
+  say(&w, "output: %s", w.out);
+  if (open_outputs(&w, 0)) return finish(&w, ctx->last_code);
+  const int err = run_all(&w, 0, 0, 0, 0, 0);
+  return finish(&w, err ? ctx->last_code : 0);
+}
+
+/**
+ * @brief Continue a workflow from the checkpoint in outdir (the `mpmc resume` command).
+ * @param flags MPMC_WORKFLOW_QUIET
+ */
+int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
+  if (!ctx) return MPMC_ERR_ARG;
+  MPMC_CHECK(outdir && outdir[0], ctx, MPMC_ERR_ARG, "output directory outdir is NULL or empty");
+#ifndef MPMC_WF_HAVE_CHECKPOINT
+  (void)flags;
+  return MPMC_ERROR(ctx, MPMC_ERR_UNSUPPORTED, "resume: this build has no checkpoints (checkpoint.c)");
+#else
+  char path[WF_PATH];
+  snprintf(path, sizeof path, "%s/checkpoint.h5", outdir);
+  mpmc_sim sim = NULL;
+  char *meta = NULL;
+  MPMC_CALL(mpmc_sim_checkpoint_read(ctx, path, &sim, &meta));
+  /* parse the workflow's record */
+  char scene[WF_PATH] = "";
+  int stage = -1, setup = 0, nset = 0, nwall = 0, ndone = 0;
+  double t_stage = 0, ke_max = 0, strength = 1;
+  long steps = 0;
+  char **sets = calloc(1, sizeof *sets);
+  int *walls = NULL;
+  stage_record *done = NULL;
+  int bad = meta == NULL || strncmp(meta, "mpmc-workflow 1\n", 16) != 0;
+  for (char *save = NULL, *line = bad ? NULL : strtok_r(meta, "\n", &save); line && !bad;
+       line = strtok_r(NULL, "\n", &save)) {
+    if (!strncmp(line, "scene ", 6))
+      snprintf(scene, sizeof scene, "%s", line + 6);
+    else if (sscanf(line, "stage %d", &stage) == 1 || sscanf(line, "setup %d", &setup) == 1 ||
+             sscanf(line, "stage_time %lf", &t_stage) == 1 || sscanf(line, "stage_steps %ld", &steps) == 1 ||
+             sscanf(line, "ke_max %lf", &ke_max) == 1 || sscanf(line, "strength %lf", &strength) == 1)
+      continue;
+    else if (!strncmp(line, "set ", 4)) {
+      char **s2 = realloc(sets, sizeof *sets * (size_t)(nset + 1));
+      bad = !s2;
+      if (s2) (sets = s2)[nset++] = strdup(line + 4);
+    } else if (!strncmp(line, "wall ", 5)) {
+      int *w2 = realloc(walls, sizeof *walls * (size_t)(nwall + 1));
+      bad = !w2;
+      if (w2) bad = sscanf(line, "wall %d", &(walls = w2)[nwall++]) != 1;
+    } else if (!strncmp(line, "done ", 5)) {
+      stage_record *d2 = realloc(done, sizeof *done * (size_t)(ndone + 1));
+      bad = !d2;
+      if (d2) {
+        done = d2;
+        char reason[32];
+        stage_record *r = &done[ndone++];
+        memset(r, 0, sizeof *r);
+        bad = sscanf(line, "done %lf %ld %lf %31s", &r->sim_time, &r->steps, &r->wall_seconds, reason) != 4;
+        r->reason = !strcmp(reason, "quasi_static") ? "quasi_static" : !strcmp(reason, "time") ? "time" : "max_time";
+      }
+    }
+  }
+  mpmc_free(meta);
+  int err = 0;
+  wf_run w = {0};
+  w.ctx = ctx;
+  w.quiet = (flags & MPMC_WORKFLOW_QUIET) != 0;
+  w.t_start = wf_now();
+  w.noverride = nset;
+  w.overrides = (const char *const *)sets;
+  snprintf(w.out, sizeof w.out, "%s", outdir);
+  if (bad || stage < 0 || !scene[0]) {
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "resume: %s was not written by the workflow (no stage record)", path);
+  } else if (prepare(&w, scene, nset, w.overrides)) {
+    err = ctx->last_code;
+  } else if (nwall != w.nwall_ids || ndone != stage || stage >= w.sc.nstage) {
+    err = fail(&w, MPMC_ERR_FORMAT, "resume: the scene %s no longer matches the checkpoint (stages or walls changed)", scene);
+  } else {
+    if (nwall) memcpy(w.wall_ids, walls, sizeof *walls * (size_t)nwall);
+    for (int i = 0; i < ndone; ++i) {
+      w.rec[i] = done[i];
+      snprintf(w.rec[i].name, sizeof w.rec[i].name, "%s", w.sc.stages[i].name);
+    }
+    w.sim = sim;
+    w.strength = strength;
+    set_threads(&w);
+    mpmc_sim_set_threads(w.sim, w.sc.threads);
+    sim = NULL;
+    if (wf_metrics_init(w.sim, &w.sc)) err = ctx->last_code;
+    say(&w, "resuming %s at stage %d/%d (%s), %.4g s into it", scene, stage + 1, w.sc.nstage,
+        w.sc.stages[stage].name, t_stage);
+    if (!err) err = open_outputs(&w, 1) ? ctx->last_code : 0;
+    if (!err) {
+      if (setup && w.sc.stages[stage].has_gravity) mpmc_sim_set_gravity(w.sim, w.sc.stages[stage].gravity);
+      if (setup) mpmc_sim_set_damping(w.sim, w.sc.stages[stage].damping);
+      err = run_all(&w, stage, t_stage, steps, ke_max, setup) ? ctx->last_code : 0;
+    }
+  }
+  mpmc_sim_destroy(&sim);
+  err = finish(&w, err);
+  for (int i = 0; i < nset; ++i) free(sets[i]);
+  free(sets);
+  free(walls);
+  free(done);
+  return err;
+#endif
+}

@@ -1,0 +1,1056 @@
+/* Scene files: YAML (libyaml's event parser) -> a tree that keeps file:line:column for
+ * every key and value, `--set key.path=value` overrides applied to that tree, and typed,
+ * range-checked reading of the tree into wf_scene.  Every error names the position and the
+ * key: "slope.yaml:12:5: key 'grid.cell_size': must be > 0 (got -1)". */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <yaml.h>
+
+#include "wf.h"
+
+/* ---- the tree --------------------------------------------------------------------- */
+void wf_node_free(wf_node *n) {
+  if (!n) return;
+  for (int i = 0; i < n->n; ++i) {
+    wf_node_free(n->items[i]);
+    if (n->keys) free(n->keys[i]);
+  }
+  free(n->items);
+  free(n->keys);
+  free(n->key_line);
+  free(n->key_col);
+  free(n->value);
+  free(n);
+}
+
+static wf_node *node_new(wf_kind kind, int line, int col, const char *origin) {
+  wf_node *n = calloc(1, sizeof *n);
+  if (!n) return NULL;
+  n->kind = kind;
+  n->line = line;
+  n->col = col;
+  n->origin = origin;
+  return n;
+}
+
+static int node_push(wf_node *parent, const char *key, int kline, int kcol, wf_node *child) {
+  if (parent->n == parent->cap) {
+    const int cap = parent->cap ? 2 * parent->cap : 8;
+    wf_node **it = realloc(parent->items, sizeof *it * (size_t)cap);
+    if (!it) return -1;
+    parent->items = it;
+    if (parent->kind == WF_MAP) {
+      char **k = realloc(parent->keys, sizeof *k * (size_t)cap);
+      if (!k) return -1;
+      parent->keys = k;
+      int *kl = realloc(parent->key_line, sizeof *kl * (size_t)cap);
+      if (!kl) return -1;
+      parent->key_line = kl;
+      int *kc = realloc(parent->key_col, sizeof *kc * (size_t)cap);
+      if (!kc) return -1;
+      parent->key_col = kc;
+    }
+    parent->cap = cap;
+  }
+  if (parent->kind == WF_MAP) {
+    parent->keys[parent->n] = strdup(key);
+    if (!parent->keys[parent->n]) return -1;
+    parent->key_line[parent->n] = kline;
+    parent->key_col[parent->n] = kcol;
+  }
+  parent->items[parent->n++] = child;
+  return 0;
+}
+
+static int map_index(const wf_node *m, const char *key) {
+  if (!m || m->kind != WF_MAP) return -1;
+  for (int i = 0; i < m->n; ++i)
+    if (strcmp(m->keys[i], key) == 0) return i;
+  return -1;
+}
+
+static const wf_node *map_get(const wf_node *m, const char *key) {
+  const int i = map_index(m, key);
+  return i < 0 ? NULL : m->items[i];
+}
+
+/* ---- parsing: events -> tree --------------------------------------------------------- */
+#define WF_DEPTH 64
+typedef struct {
+  wf_node *node;
+  char *pending_key; /* map: the key waiting for its value */
+  int kline, kcol;
+  char path[512];
+} frame;
+
+static void frame_path(const frame *st, int depth, char *out, size_t len) {
+  /* the key path of the innermost value being parsed, for syntax errors */
+  out[0] = '\0';
+  for (int i = 0; i < depth; ++i) {
+    const wf_node *n = st[i].node;
+    char seg[128] = "";
+    if (n->kind == WF_MAP && st[i].pending_key)
+      snprintf(seg, sizeof seg, "%s", st[i].pending_key);
+    else if (n->kind == WF_MAP && n->n > 0)
+      snprintf(seg, sizeof seg, "%s", n->keys[n->n - 1]);
+    else if (n->kind == WF_SEQ)
+      snprintf(seg, sizeof seg, "%d", n->n);
+    if (!seg[0]) continue;
+    const size_t l = strlen(out);
+    snprintf(out + l, len - l, "%s%s", l ? "." : "", seg);
+  }
+}
+
+/* Parse YAML text into a tree.  origin names the source in messages. */
+static wf_node *parse_yaml(const unsigned char *text, size_t len, const char *origin, char *msg,
+                           size_t msglen) {
+  yaml_parser_t parser;
+  if (!yaml_parser_initialize(&parser)) {
+    snprintf(msg, msglen, "%s: cannot initialise the YAML parser", origin);
+    return NULL;
+  }
+  yaml_parser_set_input_string(&parser, text, len);
+  frame st[WF_DEPTH];
+  int depth = 0, done = 0, ndoc = 0;
+  wf_node *root = NULL;
+  while (!done) {
+    yaml_event_t ev;
+    if (!yaml_parser_parse(&parser, &ev)) {
+      char where[512];
+      frame_path(st, depth, where, sizeof where);
+      const yaml_mark_t mk = parser.problem_mark;
+      snprintf(msg, msglen, "%s:%zu:%zu: %skey '%s': YAML syntax error: %s%s%s", origin,
+               mk.line + 1, mk.column + 1, "", where[0] ? where : "(top level)",
+               parser.problem ? parser.problem : "unknown problem",
+               parser.context ? " " : "", parser.context ? parser.context : "");
+      goto fail;
+    }
+    const int line = (int)ev.start_mark.line + 1, col = (int)ev.start_mark.column + 1;
+    wf_node *made = NULL;
+    switch (ev.type) {
+      case YAML_STREAM_END_EVENT: done = 1; break;
+      case YAML_DOCUMENT_START_EVENT:
+        if (++ndoc > 1) {
+          snprintf(msg, msglen, "%s:%d:%d: key '(top level)': a scene is a single YAML document",
+                   origin, line, col);
+          yaml_event_delete(&ev);
+          goto fail;
+        }
+        break;
+      case YAML_ALIAS_EVENT: {
+        char where[512];
+        frame_path(st, depth, where, sizeof where);
+        snprintf(msg, msglen, "%s:%d:%d: key '%s': YAML aliases (*name) are not supported", origin,
+                 line, col, where);
+        yaml_event_delete(&ev);
+        goto fail;
+      }
+      case YAML_SCALAR_EVENT:
+        if (depth > 0 && st[depth - 1].node->kind == WF_MAP && !st[depth - 1].pending_key) {
+          frame *f = &st[depth - 1];
+          const char *k = (const char *)ev.data.scalar.value;
+          if (map_index(f->node, k) >= 0) {
+            char where[512];
+            frame_path(st, depth, where, sizeof where);
+            snprintf(msg, msglen, "%s:%d:%d: key '%s%s%s': duplicate key", origin, line, col, where,
+                     where[0] ? "." : "", k);
+            yaml_event_delete(&ev);
+            goto fail;
+          }
+          f->pending_key = strdup(k);
+          f->kline = line;
+          f->kcol = col;
+          break;
+        }
+        made = node_new(WF_SCALAR, line, col, origin);
+        if (made) {
+          made->value = strdup((const char *)ev.data.scalar.value);
+          made->quoted = ev.data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
+                         ev.data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE;
+        }
+        break;
+      case YAML_SEQUENCE_START_EVENT: made = node_new(WF_SEQ, line, col, origin); break;
+      case YAML_MAPPING_START_EVENT:
+        if (depth > 0 && st[depth - 1].node->kind == WF_MAP && !st[depth - 1].pending_key) {
+          snprintf(msg, msglen, "%s:%d:%d: key '(complex)': only plain scalar keys are supported",
+                   origin, line, col);
+          yaml_event_delete(&ev);
+          goto fail;
+        }
+        made = node_new(WF_MAP, line, col, origin);
+        break;
+      case YAML_SEQUENCE_END_EVENT:
+      case YAML_MAPPING_END_EVENT: depth--; break;
+      default: break;
+    }
+    const int opens = ev.type == YAML_SEQUENCE_START_EVENT || ev.type == YAML_MAPPING_START_EVENT;
+    const int is_value = opens || (ev.type == YAML_SCALAR_EVENT && made);
+    yaml_event_delete(&ev);
+    if (is_value) {
+      if (!made) {
+        snprintf(msg, msglen, "%s: out of memory", origin);
+        goto fail;
+      }
+      if (depth == 0) {
+        root = made;
+      } else {
+        frame *f = &st[depth - 1];
+        int err = node_push(f->node, f->pending_key, f->kline, f->kcol, made);
+        free(f->pending_key);
+        f->pending_key = NULL;
+        if (err) {
+          wf_node_free(made);
+          snprintf(msg, msglen, "%s: out of memory", origin);
+          goto fail;
+        }
+      }
+      if (opens) {
+        if (depth == WF_DEPTH) {
+          snprintf(msg, msglen, "%s:%d:%d: key '(deep)': nesting deeper than %d levels", origin,
+                   line, col, WF_DEPTH);
+          goto fail;
+        }
+        st[depth].node = made;
+        st[depth].pending_key = NULL;
+        depth++;
+      }
+    }
+  }
+  yaml_parser_delete(&parser);
+  if (!root) root = node_new(WF_MAP, 1, 1, origin); /* empty document */
+  return root;
+fail:
+  for (int i = 0; i < depth; ++i) free(st[i].pending_key);
+  yaml_parser_delete(&parser);
+  wf_node_free(root);
+  return NULL;
+}
+
+/* ---- reading with checks ----------------------------------------------------------- */
+typedef struct {
+  char *msg;
+  size_t len;
+  int failed;
+} rd;
+
+static void where_of(const wf_node *n, char *buf, size_t len) {
+  if (!n)
+    snprintf(buf, len, "(scene)");
+  else if (n->line > 0)
+    snprintf(buf, len, "%s:%d:%d", n->origin, n->line, n->col);
+  else
+    snprintf(buf, len, "%s", n->origin);
+}
+
+static int fail_at(rd *r, const wf_node *n, const char *path, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static int fail_at(rd *r, const wf_node *n, const char *path, const char *fmt, ...) {
+  if (r->failed) return -1; /* keep the first message */
+  char where[WF_PATH + 32], body[WF_MSG];
+  where_of(n, where, sizeof where);
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(body, sizeof body, fmt, ap);
+  va_end(ap);
+  snprintf(r->msg, r->len, "%s: key '%s': %s", where, path, body);
+  r->failed = 1;
+  return -1;
+}
+
+static void join(char *out, size_t len, const char *path, const char *key) {
+  snprintf(out, len, "%s%s%s", path, path[0] ? "." : "", key);
+}
+
+static int edit_distance(const char *a, const char *b) {
+  const size_t la = strlen(a), lb = strlen(b);
+  if (la > 63 || lb > 63) return 99;
+  int d[64][64];
+  for (size_t i = 0; i <= la; ++i) d[i][0] = (int)i;
+  for (size_t j = 0; j <= lb; ++j) d[0][j] = (int)j;
+  for (size_t i = 1; i <= la; ++i)
+    for (size_t j = 1; j <= lb; ++j) {
+      const int c = tolower((unsigned char)a[i - 1]) != tolower((unsigned char)b[j - 1]);
+      int v = d[i - 1][j] + 1;
+      if (d[i][j - 1] + 1 < v) v = d[i][j - 1] + 1;
+      if (d[i - 1][j - 1] + c < v) v = d[i - 1][j - 1] + c;
+      d[i][j] = v;
+    }
+  return d[la][lb];
+}
+
+/* A map whose keys must all be in allowed (NULL-terminated). */
+static int check_map(rd *r, const wf_node *n, const char *path, const char *const *allowed) {
+  if (!n || n->kind != WF_MAP)
+    return fail_at(r, n, path, "expected a map of keys (got %s)",
+                   !n ? "nothing" : n->kind == WF_SEQ ? "a list" : "a value");
+  for (int i = 0; i < n->n; ++i) {
+    int ok = 0, best = 99;
+    const char *sugg = NULL;
+    for (const char *const *a = allowed; *a; ++a) {
+      if (strcmp(*a, n->keys[i]) == 0) ok = 1;
+      const int dist = edit_distance(*a, n->keys[i]);
+      if (dist < best) {
+        best = dist;
+        sugg = *a;
+      }
+    }
+    if (!ok) {
+      char full[512], where[WF_PATH + 32];
+      join(full, sizeof full, path, n->keys[i]);
+      if (r->failed) return -1;
+      snprintf(where, sizeof where, "%s:%d:%d", n->origin, n->key_line[i], n->key_col[i]);
+      if (n->line == 0 || n->key_line[i] == 0) snprintf(where, sizeof where, "--set");
+      char valid[512] = "";
+      for (const char *const *a = allowed; *a; ++a) {
+        const size_t l = strlen(valid);
+        snprintf(valid + l, sizeof valid - l, "%s%s", l ? ", " : "", *a);
+      }
+      if (sugg && best <= 3)
+        snprintf(r->msg, r->len, "%s: key '%s': unknown key (did you mean '%s'?)", where, full, sugg);
+      else
+        snprintf(r->msg, r->len, "%s: key '%s': unknown key (valid keys: %s)", where, full, valid);
+      r->failed = 1;
+      return -1;
+    }
+  }
+  return 0;
+}
+
+static int parse_number(const wf_node *n, double *v) {
+  if (!n || n->kind != WF_SCALAR || n->quoted || !n->value[0]) return -1;
+  const char *s = n->value;
+  if (!strcmp(s, ".inf") || !strcmp(s, "+.inf")) return *v = INFINITY, 0;
+  char *end;
+  errno = 0;
+  const double x = strtod(s, &end);
+  while (*end == ' ') ++end;
+  if (*end || errno == ERANGE || isnan(x)) return -1;
+  *v = x;
+  return 0;
+}
+
+static const char *shown(const wf_node *n) {
+  if (!n) return "nothing";
+  if (n->kind == WF_SEQ) return "a list";
+  if (n->kind == WF_MAP) return "a map";
+  return n->value;
+}
+
+/* Range: value must satisfy lo (<= or <) v (<= or <) hi. */
+typedef struct {
+  double lo, hi;
+  int lo_open, hi_open;
+} range;
+static const range ANY = {-INFINITY, INFINITY, 0, 0};
+static const range POS = {0, INFINITY, 1, 0};
+static const range NONNEG = {0, INFINITY, 0, 0};
+static const range UNIT = {0, 1, 0, 0};
+
+static int check_range(rd *r, const wf_node *n, const char *path, double v, range g) {
+  const int below = g.lo_open ? !(v > g.lo) : !(v >= g.lo);
+  const int above = g.hi_open ? !(v < g.hi) : !(v <= g.hi);
+  if (!below && !above && isfinite(v)) return 0;
+  if (isinf(g.hi))
+    return fail_at(r, n, path, "must be %s %g (got %g)", g.lo_open ? ">" : ">=", g.lo, v);
+  if (isinf(g.lo))
+    return fail_at(r, n, path, "must be %s %g (got %g)", g.hi_open ? "<" : "<=", g.hi, v);
+  return fail_at(r, n, path, "must be in %c%g, %g%c (got %g)", g.lo_open ? '(' : '[', g.lo, g.hi,
+                 g.hi_open ? ')' : ']', v);
+}
+
+/* Read map[key] as a number; absent: def if !required. */
+static int get_num(rd *r, const wf_node *map, const char *path, const char *key, int required,
+                   double def, range g, double *out) {
+  char full[512];
+  join(full, sizeof full, path, key);
+  const wf_node *n = map_get(map, key);
+  if (!n) {
+    if (required) return fail_at(r, map, full, "required key is missing");
+    *out = def;
+    return 0;
+  }
+  double v;
+  if (parse_number(n, &v)) return fail_at(r, n, full, "expected a number (got '%s')", shown(n));
+  if (check_range(r, n, full, v, g)) return -1;
+  *out = v;
+  return 0;
+}
+
+static int get_int(rd *r, const wf_node *map, const char *path, const char *key, int required,
+                   int def, int lo, int hi, int *out) {
+  double v;
+  char full[512];
+  join(full, sizeof full, path, key);
+  const range g = {lo, hi, 0, 0};
+  if (get_num(r, map, path, key, required, def, g, &v)) return -1;
+  if (v != floor(v)) return fail_at(r, map_get(map, key), full, "expected a whole number (got %g)", v);
+  *out = (int)v;
+  return 0;
+}
+
+static int get_bool(rd *r, const wf_node *map, const char *path, const char *key, int def, int *out) {
+  char full[512];
+  join(full, sizeof full, path, key);
+  const wf_node *n = map_get(map, key);
+  if (!n) return *out = def, 0;
+  static const char *yes[] = {"true", "yes", "on", "True", "TRUE", NULL};
+  static const char *no[] = {"false", "no", "off", "False", "FALSE", NULL};
+  if (n->kind == WF_SCALAR && !n->quoted) {
+    for (int i = 0; yes[i]; ++i)
+      if (!strcmp(n->value, yes[i])) return *out = 1, 0;
+    for (int i = 0; no[i]; ++i)
+      if (!strcmp(n->value, no[i])) return *out = 0, 0;
+  }
+  return fail_at(r, n, full, "expected true or false (got '%s')", shown(n));
+}
+
+static int get_str(rd *r, const wf_node *map, const char *path, const char *key, int required,
+                   const char *def, char *out, size_t len) {
+  char full[512];
+  join(full, sizeof full, path, key);
+  const wf_node *n = map_get(map, key);
+  if (!n) {
+    if (required) return fail_at(r, map, full, "required key is missing");
+    snprintf(out, len, "%s", def);
+    return 0;
+  }
+  if (n->kind != WF_SCALAR) return fail_at(r, n, full, "expected a text value (got %s)", shown(n));
+  if (strlen(n->value) >= len)
+    return fail_at(r, n, full, "longer than %zu characters", len - 1);
+  snprintf(out, len, "%s", n->value);
+  return 0;
+}
+
+/* One of a fixed set of words; returns its index in *out. */
+static int get_enum(rd *r, const wf_node *map, const char *path, const char *key, int required,
+                    int def, const char *const *words, int *out) {
+  char full[512], buf[WF_NAME];
+  join(full, sizeof full, path, key);
+  if (get_str(r, map, path, key, required, "", buf, sizeof buf)) return -1;
+  if (!map_get(map, key)) return *out = def, 0;
+  char list[256] = "";
+  for (int i = 0; words[i]; ++i) {
+    if (!strcmp(buf, words[i])) return *out = i, 0;
+    const size_t l = strlen(list);
+    snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", words[i]);
+  }
+  return fail_at(r, map_get(map, key), full, "must be one of %s (got '%s')", list, buf);
+}
+
+/* A list of exactly n numbers. */
+static int get_vec(rd *r, const wf_node *map, const char *path, const char *key, int required,
+                   int n, range g, double *out) {
+  char full[512];
+  join(full, sizeof full, path, key);
+  const wf_node *v = map_get(map, key);
+  if (!v) {
+    if (required) return fail_at(r, map, full, "required key is missing");
+    return 0;
+  }
+  if (v->kind != WF_SEQ || v->n != n)
+    return fail_at(r, v, full, "expected a list of %d numbers, e.g. [%s] (got %s%s)", n,
+                   n == 2 ? "0, 0" : "0, 0, 0",
+                   v->kind == WF_SEQ ? "a list of " : "'", v->kind == WF_SEQ ? "" : shown(v));
+  for (int i = 0; i < n; ++i) {
+    char item[560];
+    snprintf(item, sizeof item, "%s.%d", full, i);
+    if (parse_number(v->items[i], &out[i]))
+      return fail_at(r, v->items[i], item, "expected a number (got '%s')", shown(v->items[i]));
+    if (check_range(r, v->items[i], item, out[i], g)) return -1;
+  }
+  return 0;
+}
+
+/* ---- --set overrides ------------------------------------------------------------------- */
+static int apply_override(wf_node *root, const char *arg, const char *origin, char *msg, size_t len) {
+  const char *eq = strchr(arg, '=');
+  if (!eq || eq == arg) {
+    snprintf(msg, len, "--set %s: key '%s': expected key.path=value", arg, arg);
+    return -1;
+  }
+  char path[512];
+  const size_t pl = (size_t)(eq - arg);
+  if (pl >= sizeof path) {
+    snprintf(msg, len, "--set %s: key path too long", arg);
+    return -1;
+  }
+  memcpy(path, arg, pl);
+  path[pl] = '\0';
+  const char *val = eq + 1;
+  wf_node *value = parse_yaml((const unsigned char *)val, strlen(val), origin, msg, len);
+  if (!value) return -1;
+  /* the value's nodes report the --set argument as their origin, without line numbers */
+  wf_node *stack[WF_DEPTH];
+  int sp = 0;
+  stack[sp++] = value;
+  while (sp) {
+    wf_node *n = stack[--sp];
+    n->line = 0;
+    for (int i = 0; i < n->n && sp < WF_DEPTH; ++i) stack[sp++] = n->items[i];
+  }
+  if (value->kind == WF_MAP && value->n == 0 && !val[0]) {
+    wf_node_free(value);
+    snprintf(msg, len, "--set %s: key '%s': empty value", arg, path);
+    return -1;
+  }
+  wf_node *cur = root;
+  char *save = NULL;
+  char *seg = strtok_r(path, ".", &save);
+  char done[512] = "";
+  while (seg) {
+    char *next = strtok_r(NULL, ".", &save);
+    char sofar[512];
+    join(sofar, sizeof sofar, done, seg);
+    if (cur->kind == WF_MAP) {
+      int i = map_index(cur, seg);
+      if (!next) {
+        if (i >= 0) {
+          wf_node_free(cur->items[i]);
+          cur->items[i] = value;
+        } else if (node_push(cur, seg, 0, 0, value)) {
+          wf_node_free(value);
+          snprintf(msg, len, "out of memory");
+          return -1;
+        }
+        return 0;
+      }
+      if (i < 0) {
+        wf_node *m = node_new(WF_MAP, 0, 0, origin);
+        if (!m || node_push(cur, seg, 0, 0, m)) {
+          wf_node_free(m);
+          wf_node_free(value);
+          snprintf(msg, len, "out of memory");
+          return -1;
+        }
+        i = cur->n - 1;
+      }
+      cur = cur->items[i];
+    } else if (cur->kind == WF_SEQ) {
+      int idx = -1;
+      char *end;
+      const long l = strtol(seg, &end, 10);
+      if (!*end && l >= 0 && l < cur->n) idx = (int)l;
+      for (int i = 0; idx < 0 && i < cur->n; ++i) {
+        const wf_node *nm = map_get(cur->items[i], "name");
+        if (nm && nm->kind == WF_SCALAR && !strcmp(nm->value, seg)) idx = i;
+      }
+      if (idx < 0) {
+        snprintf(msg, len, "--set %s: key '%s': no list item '%s' (give an index 0..%d or a name)",
+                 arg, sofar, seg, cur->n - 1);
+        wf_node_free(value);
+        return -1;
+      }
+      if (!next) {
+        wf_node_free(cur->items[idx]);
+        cur->items[idx] = value;
+        return 0;
+      }
+      cur = cur->items[idx];
+    } else {
+      snprintf(msg, len, "--set %s: key '%s': is a value, it has no key '%s'", arg, done, seg);
+      wf_node_free(value);
+      return -1;
+    }
+    snprintf(done, sizeof done, "%s", sofar);
+    seg = next;
+  }
+  wf_node_free(value);
+  snprintf(msg, len, "--set %s: key '': empty key path", arg);
+  return -1;
+}
+
+/* ---- the scene schema ------------------------------------------------------------------ */
+static const char *const basis_words[] = {"linear", "ugimp", "bspline2", "bspline3", NULL};
+static const char *const model_words[] = {"hencky_j2", "hencky", "neo_hookean", "newtonian", NULL};
+static const char *const wall_kind_words[] = {"fixed", "slip", "separable", NULL};
+static const char *const axis_words[] = {"x", "y", "z", NULL};
+static const char *const face_words[] = {"x_lo", "x_hi", "y_lo", "y_hi", "z_lo", "z_hi", NULL};
+static const char *const solver_words[] = {"auto", "newton", "kinsol", NULL};
+
+const char *wf_basis_name(int b) { return b >= 0 && b < 4 ? basis_words[b] : "?"; }
+const char *wf_model_name(int m) { return m >= 0 && m < 4 ? model_words[m] : "?"; }
+
+static int read_materials(rd *r, const wf_node *root, wf_scene *sc) {
+  const wf_node *ms = map_get(root, "materials");
+  if (!ms) return fail_at(r, root, "materials", "required key is missing");
+  if (ms->kind != WF_MAP || ms->n == 0)
+    return fail_at(r, ms, "materials", "expected a map of named materials, e.g. clay: {model: hencky_j2, ...}");
+  sc->nmat = ms->n;
+  sc->mats = calloc((size_t)ms->n, sizeof *sc->mats);
+  if (!sc->mats) return fail_at(r, ms, "materials", "out of memory");
+  static const char *const keys[] = {"model", "E", "nu", "rho", "kappa_p", "kappa_r", "eta", "su", "su_r",
+                                     "K", "mu", NULL};
+  for (int i = 0; i < ms->n; ++i) {
+    wf_material *m = &sc->mats[i];
+    const wf_node *mn = ms->items[i];
+    char path[256];
+    snprintf(path, sizeof path, "materials.%s", ms->keys[i]);
+    snprintf(m->name, sizeof m->name, "%s", ms->keys[i]);
+    if (check_map(r, mn, path, keys)) return -1;
+    if (get_enum(r, mn, path, "model", 1, 0, model_words, &m->model)) return -1;
+    if (get_num(r, mn, path, "rho", 1, 0, POS, &m->rho)) return -1;
+    if (m->model == WF_MODEL_NEWTONIAN) {
+      if (get_num(r, mn, path, "K", 1, 0, POS, &m->K) || get_num(r, mn, path, "mu", 0, 0, NONNEG, &m->mu))
+        return -1;
+      continue;
+    }
+    const range nu_r = {0, 0.5, 0, 1};
+    if (get_num(r, mn, path, "E", 1, 0, POS, &m->E) || get_num(r, mn, path, "nu", 1, 0, nu_r, &m->nu))
+      return -1;
+    if (m->model != WF_MODEL_HENCKY_J2) continue;
+    /* Strength: kappa is the von Mises equivalent stress q = sqrt(3/2)|dev tau| at yield.
+     * su (undrained shear strength, plane strain / Tresca-matched) gives kappa = sqrt(3) su. */
+    const int has_k = map_get(mn, "kappa_p") != NULL, has_su = map_get(mn, "su") != NULL;
+    char full[512];
+    join(full, sizeof full, path, has_k ? "su" : "kappa_p");
+    if (has_k && has_su) return fail_at(r, map_get(mn, "su"), full, "give kappa_p/kappa_r or su/su_r, not both");
+    if (has_su) {
+      double su, sur;
+      if (get_num(r, mn, path, "su", 1, 0, POS, &su)) return -1;
+      if (get_num(r, mn, path, "su_r", 0, su, POS, &sur)) return -1;
+      m->kappa_p = sqrt(3.0) * su;
+      m->kappa_r = sqrt(3.0) * sur;
+      join(full, sizeof full, path, "su_r");
+      if (sur > su) return fail_at(r, map_get(mn, "su_r"), full, "must not exceed su = %g (got %g)", su, sur);
+    } else {
+      if (get_num(r, mn, path, "kappa_p", 1, 0, POS, &m->kappa_p)) return -1;
+      if (get_num(r, mn, path, "kappa_r", 0, m->kappa_p, POS, &m->kappa_r)) return -1;
+      join(full, sizeof full, path, "kappa_r");
+      if (m->kappa_r > m->kappa_p)
+        return fail_at(r, map_get(mn, "kappa_r"), full, "must not exceed kappa_p = %g (got %g)",
+                       m->kappa_p, m->kappa_r);
+    }
+    if (get_num(r, mn, path, "eta", 0, 0, NONNEG, &m->eta)) return -1;
+  }
+  return 0;
+}
+
+static int find_material(rd *r, const wf_scene *sc, const wf_node *map, const char *path, int *out) {
+  char name[WF_NAME], full[512];
+  join(full, sizeof full, path, "material");
+  if (get_str(r, map, path, "material", sc->nmat != 1, sc->mats[0].name, name, sizeof name)) return -1;
+  for (int i = 0; i < sc->nmat; ++i)
+    if (!strcmp(sc->mats[i].name, name)) return *out = i, 0;
+  char list[256] = "";
+  for (int i = 0; i < sc->nmat; ++i) {
+    const size_t l = strlen(list);
+    snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", sc->mats[i].name);
+  }
+  return fail_at(r, map_get(map, "material"), full, "no material '%s' (materials: %s)", name, list);
+}
+
+static int file_exists(const char *p) {
+  struct stat s;
+  return stat(p, &s) == 0 && S_ISREG(s.st_mode);
+}
+
+static int read_geometry(rd *r, const wf_node *root, wf_scene *sc) {
+  const wf_node *gs = map_get(root, "geometry");
+  if (!gs) return fail_at(r, root, "geometry", "required key is missing");
+  if (gs->kind != WF_SEQ || gs->n == 0)
+    return fail_at(r, gs, "geometry", "expected a list of bodies, e.g. - {type: box, lo: [..], hi: [..]}");
+  sc->nbody = gs->n;
+  sc->bodies = calloc((size_t)gs->n, sizeof *sc->bodies);
+  if (!sc->bodies) return fail_at(r, gs, "geometry", "out of memory");
+  static const char *const types[] = {"box", "polygon", "gmsh", NULL};
+  static const char *const modes[] = {"lattice", "quadrature", NULL};
+  static const char *const keys[] = {"type", "material", "ppc", "lo", "hi", "vertices", "file",
+                                     "seeding", "region", "velocity", NULL};
+  for (int i = 0; i < gs->n; ++i) {
+    wf_body *b = &sc->bodies[i];
+    const wf_node *g = gs->items[i];
+    char path[64], full[512];
+    snprintf(path, sizeof path, "geometry.%d", i);
+    if (check_map(r, g, path, keys)) return -1;
+    if (get_enum(r, g, path, "type", 1, 0, types, &b->type)) return -1;
+    if (find_material(r, sc, g, path, &b->material)) return -1;
+    if (get_int(r, g, path, "ppc", 0, 2, 1, 8, &b->ppc)) return -1;
+    if (get_vec(r, g, path, "velocity", 0, sc->dim, ANY, b->velocity)) return -1;
+    if (b->type == WF_GEOM_BOX) {
+      if (get_vec(r, g, path, "lo", 1, sc->dim, ANY, b->lo) || get_vec(r, g, path, "hi", 1, sc->dim, ANY, b->hi))
+        return -1;
+      for (int a = 0; a < sc->dim; ++a)
+        if (b->hi[a] <= b->lo[a]) {
+          join(full, sizeof full, path, "hi");
+          return fail_at(r, map_get(g, "hi"), full, "component %d must be > lo (%g) (got %g)", a,
+                         b->lo[a], b->hi[a]);
+        }
+    } else if (b->type == WF_GEOM_POLYGON) {
+      join(full, sizeof full, path, "vertices");
+      const wf_node *v = map_get(g, "vertices");
+      if (sc->dim != 2) return fail_at(r, map_get(g, "type"), full, "polygons are 2D only (dim = %d)", sc->dim);
+      if (!v) return fail_at(r, g, full, "required key is missing");
+      if (v->kind != WF_SEQ || v->n < 3)
+        return fail_at(r, v, full, "expected a list of at least 3 [x, y] points");
+      b->nvert = v->n;
+      b->xy = malloc(sizeof(double) * 2 * (size_t)v->n);
+      if (!b->xy) return fail_at(r, v, full, "out of memory");
+      for (int k = 0; k < v->n; ++k) {
+        char item[560];
+        snprintf(item, sizeof item, "%s.%d", full, k);
+        const wf_node *p = v->items[k];
+        double xy[2];
+        if (!p || p->kind != WF_SEQ || p->n != 2 || parse_number(p->items[0], &xy[0]) ||
+            parse_number(p->items[1], &xy[1]))
+          return fail_at(r, p, item, "expected a point [x, y] (got %s)", shown(p));
+        b->xy[2 * k] = xy[0];
+        b->xy[2 * k + 1] = xy[1];
+      }
+    } else {
+      char file[WF_PATH];
+      join(full, sizeof full, path, "file");
+      if (get_str(r, g, path, "file", 1, "", file, sizeof file)) return -1;
+      if (file[0] == '/')
+        snprintf(b->file, sizeof b->file, "%s", file);
+      else if (snprintf(b->file, sizeof b->file, "%s/%s", sc->dir, file) >= (int)sizeof b->file)
+        return fail_at(r, map_get(g, "file"), full, "path too long");
+      if (!file_exists(b->file))
+        return fail_at(r, map_get(g, "file"), full, "mesh file '%s' not found (paths are relative to the scene file)",
+                       b->file);
+      if (get_enum(r, g, path, "seeding", 0, MPMC_SEED_LATTICE, modes, &b->mode)) return -1;
+      if (get_str(r, g, path, "region", 1, "", b->region, sizeof b->region)) return -1;
+    }
+  }
+  return 0;
+}
+
+static int read_walls(rd *r, const wf_node *list, const char *path, const wf_scene *sc, wf_stage *s) {
+  if (list->kind != WF_SEQ) return fail_at(r, list, path, "expected a list of walls");
+  s->nwalls = list->n;
+  s->walls = calloc((size_t)list->n + 1, sizeof *s->walls);
+  if (!s->walls) return fail_at(r, list, path, "out of memory");
+  static const char *const keys[] = {"name", "kind", "face", "axis", "side", "position", "lo", "hi", NULL};
+  static const char *const sides[] = {"below", "above", NULL};
+  for (int i = 0; i < list->n; ++i) {
+    wf_wall *w = &s->walls[i];
+    const wf_node *n = list->items[i];
+    char p[256], full[512];
+    snprintf(p, sizeof p, "%s.%d", path, i);
+    if (check_map(r, n, p, keys)) return -1;
+    if (get_str(r, n, p, "name", 0, "", w->name, sizeof w->name)) return -1;
+    if (get_enum(r, n, p, "kind", 1, 0, wall_kind_words, &w->kind)) return -1;
+    int side = 0;
+    if (map_get(n, "face")) {
+      w->form = 0;
+      if (get_enum(r, n, p, "face", 1, 0, face_words, &w->face)) return -1;
+      join(full, sizeof full, p, "face");
+      if (w->face >= 2 * sc->dim) return fail_at(r, map_get(n, "face"), full, "no such face in %dD", sc->dim);
+    } else if (map_get(n, "position")) {
+      w->form = 1;
+      if (get_enum(r, n, p, "axis", 1, 0, axis_words, &w->axis)) return -1;
+      if (get_num(r, n, p, "position", 1, 0, ANY, &w->position)) return -1;
+      if (get_enum(r, n, p, "side", 1, 0, sides, &side)) return -1;
+      w->side = side ? 1 : -1;
+    } else if (map_get(n, "lo") || map_get(n, "hi")) {
+      w->form = 2;
+      if (get_vec(r, n, p, "lo", 1, sc->dim, ANY, w->lo) || get_vec(r, n, p, "hi", 1, sc->dim, ANY, w->hi))
+        return -1;
+      if (get_enum(r, n, p, "axis", w->kind != MPMC_WALL_FIXED, 0, axis_words, &w->axis)) return -1;
+      if (get_enum(r, n, p, "side", w->kind == MPMC_WALL_SEPARABLE, 0, sides, &side)) return -1;
+      w->side = side ? 1 : -1;
+    } else {
+      return fail_at(r, n, p, "a wall needs face, or axis+position+side, or a box lo+hi");
+    }
+    join(full, sizeof full, p, "axis");
+    if (w->axis >= sc->dim) return fail_at(r, map_get(n, "axis"), full, "no axis z in 2D");
+  }
+  return 0;
+}
+
+static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
+  const wf_node *ss = map_get(root, "stages");
+  if (!ss) return fail_at(r, root, "stages", "required key is missing");
+  if (ss->kind != WF_SEQ || ss->n == 0) return fail_at(r, ss, "stages", "expected a list of stages");
+  sc->nstage = ss->n;
+  sc->stages = calloc((size_t)ss->n, sizeof *sc->stages);
+  if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
+  static const char *const keys[] = {"name", "gravity", "damping", "walls", "remove_walls", "tractions",
+                                     "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
+                                     "snapshots", "series_points", NULL};
+  static const char *const end_keys[] = {"time", "kinetic_energy_ratio", "max_time", "min_time", NULL};
+  static const char *const tr_keys[] = {"set", "lo", "hi", "traction", NULL};
+  for (int i = 0; i < ss->n; ++i) {
+    wf_stage *s = &sc->stages[i];
+    const wf_node *n = ss->items[i];
+    char p[64], full[512], def[WF_NAME];
+    snprintf(p, sizeof p, "stages.%d", i);
+    snprintf(def, sizeof def, "stage%d", i + 1);
+    if (check_map(r, n, p, keys)) return -1;
+    if (get_str(r, n, p, "name", 0, def, s->name, sizeof s->name)) return -1;
+    if (map_get(n, "gravity")) {
+      s->has_gravity = 1;
+      if (get_vec(r, n, p, "gravity", 1, sc->dim, ANY, s->gravity)) return -1;
+    }
+    const range damp = {0, 1, 0, 1};
+    if (get_num(r, n, p, "damping", 0, 0, damp, &s->damping)) return -1;
+    const range srf = {0, INFINITY, 1, 0};
+    /* 0: unchanged from the previous stage */
+    if (get_num(r, n, p, "strength_reduction", 0, 0.0, srf, &s->strength_reduction)) return -1;
+    if (get_bool(r, n, p, "reset_velocity", 0, &s->reset_velocity)) return -1;
+    const range fac = {0, 1, 1, 0};
+    if (get_num(r, n, p, "dt_factor", 0, 0.3, fac, &s->dt_factor)) return -1;
+    if (get_num(r, n, p, "dt", 0, 0, NONNEG, &s->dt)) return -1;
+    if (get_int(r, n, p, "snapshots", 0, 4, 0, 100000, &s->snapshots)) return -1;
+    if (get_int(r, n, p, "series_points", 0, 200, 1, 10000000, &s->series_points)) return -1;
+    char wp[128];
+    snprintf(wp, sizeof wp, "%s.walls", p);
+    if (map_get(n, "walls") && read_walls(r, map_get(n, "walls"), wp, sc, s)) return -1;
+    const wf_node *rm = map_get(n, "remove_walls");
+    if (rm) {
+      join(full, sizeof full, p, "remove_walls");
+      if (rm->kind != WF_SEQ) return fail_at(r, rm, full, "expected a list of wall names");
+      s->nremove = rm->n;
+      s->remove = calloc((size_t)rm->n + 1, sizeof *s->remove);
+      if (!s->remove) return fail_at(r, rm, full, "out of memory");
+      for (int k = 0; k < rm->n; ++k) {
+        if (rm->items[k]->kind != WF_SCALAR) return fail_at(r, rm->items[k], full, "expected a wall name");
+        snprintf(s->remove[k], WF_NAME, "%s", rm->items[k]->value);
+        /* the name must belong to a wall of an earlier stage */
+        int found = 0;
+        for (int j = 0; j < i && !found; ++j)
+          for (int w = 0; w < sc->stages[j].nwalls; ++w)
+            if (!strcmp(sc->stages[j].walls[w].name, s->remove[k])) found = 1;
+        if (!found)
+          return fail_at(r, rm->items[k], full, "no wall named '%s' in an earlier stage", s->remove[k]);
+      }
+    }
+    const wf_node *tr = map_get(n, "tractions");
+    if (tr) {
+      join(full, sizeof full, p, "tractions");
+      if (tr->kind != WF_SEQ) return fail_at(r, tr, full, "expected a list of tractions");
+      s->ntractions = tr->n;
+      s->tractions = calloc((size_t)tr->n + 1, sizeof *s->tractions);
+      if (!s->tractions) return fail_at(r, tr, full, "out of memory");
+      for (int k = 0; k < tr->n; ++k) {
+        char tp[600];
+        snprintf(tp, sizeof tp, "%s.%d", full, k);
+        wf_traction *t = &s->tractions[k];
+        if (check_map(r, tr->items[k], tp, tr_keys)) return -1;
+        if (get_str(r, tr->items[k], tp, "set", 0, "", t->set, sizeof t->set)) return -1;
+        t->has_region = map_get(tr->items[k], "lo") != NULL;
+        if (t->has_region && (get_vec(r, tr->items[k], tp, "lo", 1, sc->dim, ANY, t->lo) ||
+                              get_vec(r, tr->items[k], tp, "hi", 1, sc->dim, ANY, t->hi)))
+          return -1;
+        if (!t->has_region && !t->set[0])
+          return fail_at(r, tr->items[k], tp, "a traction needs a particle set or a region lo/hi");
+        if (get_vec(r, tr->items[k], tp, "traction", 1, sc->dim, ANY, t->traction)) return -1;
+      }
+    }
+    const wf_node *e = map_get(n, "end");
+    join(full, sizeof full, p, "end");
+    if (!e) return fail_at(r, n, full, "required key is missing (time: T, or kinetic_energy_ratio: tol with max_time: T)");
+    if (check_map(r, e, full, end_keys)) return -1;
+    const int has_t = map_get(e, "time") != NULL, has_k = map_get(e, "kinetic_energy_ratio") != NULL;
+    if (has_t == has_k)
+      return fail_at(r, e, full, "give exactly one of time (a duration) or kinetic_energy_ratio (quasi-static)");
+    if (has_t) {
+      s->end_kind = WF_END_TIME;
+      if (get_num(r, e, full, "time", 1, 0, POS, &s->end_time)) return -1;
+    } else {
+      s->end_kind = WF_END_QUASI_STATIC;
+      const range tol = {0, 1, 1, 1};
+      if (get_num(r, e, full, "kinetic_energy_ratio", 1, 0, tol, &s->ke_ratio)) return -1;
+      if (get_num(r, e, full, "max_time", 1, 0, POS, &s->max_time)) return -1;
+      if (get_num(r, e, full, "min_time", 0, 0, NONNEG, &s->min_time)) return -1;
+      s->end_time = s->max_time;
+    }
+  }
+  return 0;
+}
+
+static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
+  const wf_node *m = map_get(root, "metrics");
+  if (!m) return 0;
+  static const char *const keys[] = {"runout_distance", "tip_displacement_y", "tip_displacement_x",
+                                     "center_of_mass_x", NULL};
+  if (check_map(r, m, "metrics", keys)) return -1;
+  static const char *const rk[] = {"toe", "axis", NULL};
+  static const char *const tk[] = {"point", NULL};
+  static const char *const none[] = {NULL};
+  for (int i = 0; i < m->n; ++i) {
+    char p[128];
+    snprintf(p, sizeof p, "metrics.%s", m->keys[i]);
+    const wf_node *v = m->items[i];
+    /* an empty value ("center_of_mass_x:") means "with defaults" */
+    const int empty = v->kind == WF_SCALAR && !v->quoted && (!v->value[0] || !strcmp(v->value, "~") ||
+                                                              !strcmp(v->value, "null"));
+    if (!strcmp(m->keys[i], "runout_distance")) {
+      sc->metrics.enabled[WF_METRIC_RUNOUT] = 1;
+      if (empty) continue;
+      if (check_map(r, v, p, rk)) return -1;
+      sc->metrics.has_toe = map_get(v, "toe") != NULL;
+      if (get_num(r, v, p, "toe", 0, 0, ANY, &sc->metrics.toe)) return -1;
+      if (get_enum(r, v, p, "axis", 0, 0, axis_words, &sc->metrics.runout_axis)) return -1;
+    } else if (!strncmp(m->keys[i], "tip_displacement", 16)) {
+      sc->metrics.enabled[m->keys[i][17] == 'y' ? WF_METRIC_TIP_Y : WF_METRIC_TIP_X] = 1;
+      if (check_map(r, v, p, tk)) return -1;
+      if (get_vec(r, v, p, "point", 1, sc->dim, ANY, sc->metrics.point)) return -1;
+    } else {
+      sc->metrics.enabled[WF_METRIC_COM_X] = 1;
+      if (!empty && check_map(r, v, p, none)) return -1;
+    }
+  }
+  return 0;
+}
+
+static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
+  static const char *const keys[] = {"scene", "description", "dim", "geometry", "grid", "basis", "fbar",
+                                     "flip", "solver", "threads", "materials", "stages", "metrics",
+                                     "plots", "checkpoint_interval", "progress_interval", NULL};
+  if (check_map(r, root, "", keys)) return -1;
+  char def[WF_NAME];
+  const char *base = strrchr(sc->path, '/');
+  snprintf(def, sizeof def, "%s", base ? base + 1 : sc->path);
+  char *dot = strrchr(def, '.');
+  if (dot) *dot = '\0';
+  if (get_str(r, root, "", "scene", 0, def, sc->name, sizeof sc->name)) return -1;
+  for (const char *c = sc->name; *c; ++c)
+    if (!isalnum((unsigned char)*c) && *c != '_' && *c != '-')
+      return fail_at(r, map_get(root, "scene"), "scene", "use letters, digits, _ and - only (got '%s')", sc->name);
+  if (get_int(r, root, "", "dim", 1, 2, 2, 3, &sc->dim)) return -1;
+  const wf_node *g = map_get(root, "grid");
+  static const char *const gk[] = {"lo", "hi", "cell_size", NULL};
+  if (!g) return fail_at(r, root, "grid", "required key is missing");
+  if (check_map(r, g, "grid", gk)) return -1;
+  if (get_vec(r, g, "grid", "lo", 1, sc->dim, ANY, sc->lo) || get_vec(r, g, "grid", "hi", 1, sc->dim, ANY, sc->hi))
+    return -1;
+  for (int a = 0; a < sc->dim; ++a)
+    if (sc->hi[a] <= sc->lo[a])
+      return fail_at(r, map_get(g, "hi"), "grid.hi", "component %d must be > grid.lo (%g) (got %g)", a,
+                     sc->lo[a], sc->hi[a]);
+  if (get_num(r, g, "grid", "cell_size", 1, 0, POS, &sc->h)) return -1;
+  for (int a = 0; a < sc->dim; ++a)
+    if (sc->h > sc->hi[a] - sc->lo[a])
+      return fail_at(r, map_get(g, "cell_size"), "grid.cell_size",
+                     "must not exceed the grid's extent %g along axis %d (got %g)", sc->hi[a] - sc->lo[a], a, sc->h);
+  if (get_enum(r, root, "", "basis", 0, MPMC_BASIS_BSPLINE2, basis_words, &sc->basis)) return -1;
+  /* fbar: true (= paper, Algorithm 1 as published), false, paper or total */
+  {
+    const wf_node *fn = map_get(root, "fbar");
+    if (fn && fn->kind == WF_SCALAR && !fn->quoted && !strcmp(fn->value, "paper"))
+      sc->fbar = MPMC_FBAR_PAPER;
+    else if (fn && fn->kind == WF_SCALAR && !fn->quoted && !strcmp(fn->value, "total"))
+      sc->fbar = MPMC_FBAR_TOTAL;
+    else if (get_bool(r, root, "", "fbar", 1, &sc->fbar))
+      return -1;
+    else if (sc->fbar)
+      sc->fbar = MPMC_FBAR_PAPER;
+  }
+  if (get_num(r, root, "", "flip", 0, 1.0, UNIT, &sc->flip)) return -1;
+  if (get_enum(r, root, "", "solver", 0, MPMC_SOLVER_AUTO, solver_words, &sc->solver)) return -1;
+  if (get_int(r, root, "", "threads", 0, 0, 0, 1024, &sc->threads)) return -1;
+  if (get_bool(r, root, "", "plots", 1, &sc->plots)) return -1;
+  if (get_num(r, root, "", "checkpoint_interval", 0, 300, POS, &sc->checkpoint_interval)) return -1;
+  if (get_num(r, root, "", "progress_interval", 0, 5, POS, &sc->progress_interval)) return -1;
+  if (read_materials(r, root, sc) || read_geometry(r, root, sc) || read_stages(r, root, sc) ||
+      read_metrics(r, root, sc))
+    return -1;
+  return 0;
+}
+
+/**
+ * @brief Read a scene file, apply the `key.path=value` overrides and check every value.
+ * @param msg receives "file:line:col: key 'a.b': what is wrong" on failure
+ */
+int wf_scene_load(const char *path, int noverride, const char *const *overrides, wf_scene *sc,
+                  char *msg, size_t msglen) {
+  memset(sc, 0, sizeof *sc);
+  msg[0] = '\0';
+  if (snprintf(sc->path, sizeof sc->path, "%s", path) >= (int)sizeof sc->path) {
+    snprintf(msg, msglen, "%s: path too long", path);
+    return MPMC_ERR_ARG;
+  }
+  snprintf(sc->dir, sizeof sc->dir, "%s", path);
+  char *slash = strrchr(sc->dir, '/');
+  if (slash)
+    *slash = '\0';
+  else
+    snprintf(sc->dir, sizeof sc->dir, ".");
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    snprintf(msg, msglen, "%s: cannot open the scene file: %s", path, strerror(errno));
+    return MPMC_ERR_IO;
+  }
+  size_t cap = 1 << 16, len = 0;
+  unsigned char *text = malloc(cap);
+  while (text) {
+    const size_t got = fread(text + len, 1, cap - len, f);
+    len += got;
+    if (len < cap) break;
+    unsigned char *t = realloc(text, cap * 2);
+    if (!t) {
+      free(text);
+      text = NULL;
+      break;
+    }
+    text = t;
+    cap *= 2;
+  }
+  fclose(f);
+  if (!text) {
+    snprintf(msg, msglen, "%s: out of memory", path);
+    return MPMC_ERR_MEMORY;
+  }
+  wf_node *root = parse_yaml(text, len, sc->path, msg, msglen);
+  free(text);
+  if (!root) return MPMC_ERR_FORMAT;
+  /* messages about overridden values name the --set argument */
+  char **origins = calloc((size_t)noverride + 1, sizeof *origins);
+  int err = origins ? 0 : MPMC_ERR_MEMORY;
+  for (int i = 0; i < noverride && !err; ++i) {
+    const size_t l = overrides && overrides[i] ? strlen(overrides[i]) + 8 : 0;
+    if (l) origins[i] = malloc(l);
+    if (origins[i]) snprintf(origins[i], l, "--set %s", overrides[i]);
+    if (!origins[i] || apply_override(root, overrides[i], origins[i], msg, msglen)) {
+      if (!msg[0]) snprintf(msg, msglen, "--set: override %d is NULL", i);
+      err = MPMC_ERR_ARG;
+    }
+  }
+  rd r = {msg, msglen, 0};
+  if (!err) err = read_scene(&r, root, sc) ? MPMC_ERR_ARG : 0;
+  wf_node_free(root);
+  for (int i = 0; i < noverride && origins; ++i) free(origins[i]);
+  free(origins);
+  if (err) {
+    wf_scene_free(sc);
+    return MPMC_ERR_ARG;
+  }
+  return MPMC_SUCCESS;
+}
+
+void wf_scene_free(wf_scene *sc) {
+  if (!sc) return;
+  for (int i = 0; i < sc->nbody && sc->bodies; ++i) free(sc->bodies[i].xy);
+  for (int i = 0; i < sc->nstage && sc->stages; ++i) {
+    free(sc->stages[i].walls);
+    free(sc->stages[i].remove);
+    free(sc->stages[i].tractions);
+  }
+  free(sc->bodies);
+  free(sc->stages);
+  free(sc->mats);
+  sc->bodies = NULL;
+  sc->stages = NULL;
+  sc->mats = NULL;
+}
+
+/* ---- plain YAML access for the test driver (scene_check.c) ------------------------------ */
+/** @brief Parse a YAML (or JSON) file into a tree; NULL with a message on failure. */
+wf_node *wf_yaml_load(const char *path, char *msg, size_t len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) {
+    snprintf(msg, len, "%s: %s", path, strerror(errno));
+    return NULL;
+  }
+  static unsigned char buf[1 << 20];
+  const size_t n = fread(buf, 1, sizeof buf, f);
+  fclose(f);
+  return parse_yaml(buf, n, path, msg, len);
+}
+
+const wf_node *wf_map_get(const wf_node *map, const char *key) { return map_get(map, key); }

@@ -1,0 +1,167 @@
+/* Private declarations of the workflow front end (libmpmc_workflow).  Not installed.
+ *
+ * scene.c    YAML -> a small tree with file:line:column on every node, --set overrides,
+ *            typed and range-checked reading of that tree into wf_scene
+ * run.c      mpmc_workflow_run: builds the simulation and runs the stages
+ * report.c   progress line/bar, series.csv, summary.json, metrics
+ * plot.c     PNG plots through gnuplot (a child process)
+ * gmsh_plugin.c  libmpmc_gmsh loaded with dlopen only when a scene seeds from gmsh
+ */
+#ifndef MPMC_WF_H
+#define MPMC_WF_H
+
+#include <stdio.h>
+
+#include "mpmc.h"
+
+#define WF_NAME 64
+#define WF_PATH 4096
+#define WF_MSG 1024
+
+/* ---- the YAML tree (scene.c) ----------------------------------------------------- */
+typedef enum { WF_SCALAR = 0, WF_SEQ = 1, WF_MAP = 2 } wf_kind;
+typedef struct wf_node {
+  wf_kind kind;
+  char *value;              /* scalar text                                          */
+  int quoted;               /* the scalar was quoted: always a string               */
+  int line, col;            /* 1-based position; 0 for values given with --set      */
+  const char *origin;       /* file name, or the --set argument                     */
+  int n, cap;
+  char **keys;              /* map keys (NULL for sequences)                         */
+  int *key_line, *key_col;  /* positions of the keys                                 */
+  struct wf_node **items;
+} wf_node;
+
+void wf_node_free(wf_node *n);
+wf_node *wf_yaml_load(const char *path, char *msg, size_t len);
+const wf_node *wf_map_get(const wf_node *map, const char *key);
+
+/* ---- the scene as read (scene.c) ------------------------------------------------- */
+typedef enum { WF_MODEL_HENCKY_J2, WF_MODEL_HENCKY, WF_MODEL_NEO_HOOKEAN, WF_MODEL_NEWTONIAN } wf_model;
+typedef struct {
+  char name[WF_NAME];
+  int model;
+  double E, nu, rho, kappa_p, kappa_r, eta, K, mu;
+  int id; /* in the simulation */
+} wf_material;
+
+typedef enum { WF_GEOM_BOX, WF_GEOM_POLYGON, WF_GEOM_GMSH } wf_geom_type;
+typedef struct {
+  int type;
+  int material;             /* index into scene materials                           */
+  int ppc;
+  double lo[3], hi[3];      /* box                                                  */
+  int nvert;                /* polygon                                              */
+  double *xy;
+  char file[WF_PATH];       /* gmsh: absolute or relative to the scene file          */
+  int mode;                 /* mpmc_seed_mode                                       */
+  char region[WF_NAME];
+  double velocity[3];       /* initial velocity                                     */
+} wf_body;
+
+typedef struct {
+  char name[WF_NAME];       /* "" when unnamed                                      */
+  int kind;                 /* mpmc_wall_kind                                       */
+  int form;                 /* 0 face, 1 plane, 2 box                               */
+  int face, axis, side;
+  double position, lo[3], hi[3];
+} wf_wall;
+
+typedef struct {
+  char set[WF_NAME];        /* particle set, or "" for the region                   */
+  int has_region;
+  double lo[3], hi[3];
+  double traction[3];       /* [Pa]                                                 */
+} wf_traction;
+
+typedef enum { WF_END_TIME = 0, WF_END_QUASI_STATIC = 1 } wf_end_kind;
+typedef struct {
+  char name[WF_NAME];
+  int has_gravity;
+  double gravity[3];
+  double damping;
+  int nwalls;
+  wf_wall *walls;
+  int nremove;
+  char (*remove)[WF_NAME];
+  int ntractions;
+  wf_traction *tractions;
+  double strength_reduction; /* strengths are the material's / this factor from this
+                              * stage on (absolute, not cumulative); 0 = unchanged   */
+  int reset_velocity;
+  int end_kind;
+  double end_time;           /* stage duration [s] (WF_END_TIME)                    */
+  double ke_ratio, max_time, min_time; /* quasi-static end                          */
+  double dt_factor, dt;      /* dt > 0: fixed step                                  */
+  int snapshots;             /* HDF5 snapshots during the stage (plus its end)      */
+  int series_points;         /* rows of series.csv for the stage                    */
+} wf_stage;
+
+typedef enum { WF_METRIC_RUNOUT, WF_METRIC_TIP_Y, WF_METRIC_TIP_X, WF_METRIC_COM_X, WF_METRIC_COUNT } wf_metric_kind;
+typedef struct {
+  int enabled[WF_METRIC_COUNT];
+  int has_toe;
+  double toe;                /* runout: initial toe abscissa                        */
+  int runout_axis;
+  double point[3];           /* tip displacement: the point whose motion is tracked */
+  int tip_index;             /* the nearest material point (set at run time)        */
+} wf_metrics;
+
+typedef struct {
+  char path[WF_PATH];        /* the scene file as given                             */
+  char dir[WF_PATH];         /* its directory (for relative mesh paths)             */
+  char name[WF_NAME];
+  int dim;
+  int basis, fbar, solver, threads;
+  double flip;
+  double lo[3], hi[3], h;
+  int nmat;
+  wf_material *mats;
+  int nbody;
+  wf_body *bodies;
+  int nstage;
+  wf_stage *stages;
+  wf_metrics metrics;
+  int plots;                 /* write PNG plots                                     */
+  double checkpoint_interval;/* wall seconds between checkpoints inside a stage     */
+  double progress_interval;  /* wall seconds between plain progress lines           */
+} wf_scene;
+
+/* Load, override and read a scene.  On failure returns non-zero with a message
+ * "file:line:col: key 'a.b': ..." in msg. */
+int wf_scene_load(const char *path, int noverride, const char *const *overrides, wf_scene *scene,
+                  char *msg, size_t msglen);
+void wf_scene_free(wf_scene *scene);
+const char *wf_basis_name(int basis);
+const char *wf_model_name(int model);
+
+/* ---- reports (report.c) ---------------------------------------------------------- */
+extern const char *const wf_metric_names[WF_METRIC_COUNT];
+/* Compute the enabled metrics of the current state into values[WF_METRIC_COUNT]. */
+int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *values);
+/* Resolve per-run metric data (toe, tracked point) from the initial state. */
+int wf_metrics_init(mpmc_sim sim, wf_scene *sc);
+
+typedef struct {
+  int tty;
+  double last_print, start, stage_start;
+  int width, stage;
+} wf_progress;
+void wf_progress_init(wf_progress *p);
+/* frac < 0: unknown (quasi-static stages before their maximum time is near) */
+void wf_progress_update(wf_progress *p, const wf_scene *sc, int stage, double t_stage,
+                        double t_end, long steps, double steps_per_s, double interval, int force);
+void wf_progress_done(wf_progress *p);
+
+/* ---- plots (plot.c) -------------------------------------------------------------- */
+/* Final state (coloured by mean stress and equivalent plastic strain) and time series.
+ * Returns 0, or 1 when gnuplot is missing or failed (a warning, not an error). */
+int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *warn, size_t len);
+
+/* ---- gmsh (gmsh_plugin.c) -------------------------------------------------------- */
+int wf_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
+                 int material, int *first, int *count, char *msg, size_t len);
+
+double wf_now(void);
+
+#endif
