@@ -23,6 +23,14 @@ static mpmc_context test_ctx __attribute__((unused));
                test_ctx ? mpmc_context_last_error(test_ctx) : mpmc_error_string(tcall_ierr_)); \
   } while (0)
 
+/* |got - want| <= tol, else fail with both values */
+#define TCLOSE(got, want, tol)                                                              \
+  do {                                                                                      \
+    const double tg_ = (got), tw_ = (want), tt_ = (tol);                                    \
+    if (!(fabs(tg_ - tw_) <= tt_))                                                          \
+      fail_msg("%s = %.17g, expected %.17g (tolerance %g)", #got, tg_, tw_, tt_);           \
+  } while (0)
+
 /* Seed a box [lo, hi] (whole cells of size h) with ppc points per cell per axis.
  * Returns the number of points; x and vol are malloc'ed. */
 static inline int test_lattice(int dim, const double *lo, const double *hi, double h, int ppc,

@@ -1,0 +1,101 @@
+/* Throughput benchmark (issues 2 and 6): particle-steps per second for
+ *   block  - a 3D elastic (Hencky) block, quadratic B-splines, F-bar off / on
+ *   column - the 3D column collapse of issue 6: 2 x 0.5 x 1 m domain, h = 0.025 m, a 0.5 m
+ *            cube of J2 soil with 2x2x2 points per cell (64,000 points), gravity
+ * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale]; scale multiplies the number
+ * of cells per axis of the column (1 = 64,000 points). */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "mpmc.h"
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+#define CHECK(expr)                                                                        \
+  do {                                                                                     \
+    int e_ = (expr);                                                                       \
+    if (e_) {                                                                              \
+      fprintf(stderr, "%s failed: %s\n", #expr, mpmc_context_last_error(ctx));             \
+      exit(1);                                                                             \
+    }                                                                                      \
+  } while (0)
+
+/* returns particle-steps per second; *np the number of points */
+static double run(int scene, int basis, int fbar, int j2, int threads, int steps, double scale,
+                  int *np) {
+  mpmc_context ctx;
+  mpmc_sim sim;
+  mpmc_context_create(&ctx);
+  CHECK(mpmc_sim_create(ctx, 3, &sim));
+  double h, lo[3] = {0, 0, 0}, hi[3], blo[3] = {0, 0, 0}, bhi[3];
+  if (scene == 0) { /* block */
+    h = 0.05 / scale;
+    hi[0] = hi[1] = hi[2] = 1.0;
+    bhi[0] = bhi[1] = bhi[2] = 0.5;
+  } else { /* column collapse */
+    h = 0.025 / scale;
+    hi[0] = 2.0, hi[1] = 0.5, hi[2] = 1.0;
+    bhi[0] = bhi[1] = bhi[2] = 0.5;
+  }
+  CHECK(mpmc_sim_set_grid(sim, lo, hi, h));
+  CHECK(mpmc_sim_set_basis(sim, basis));
+  CHECK(mpmc_sim_set_fbar(sim, fbar));
+  CHECK(mpmc_sim_set_threads(sim, threads));
+  int mat;
+  if (j2)
+    CHECK(mpmc_sim_add_material_hencky_j2(sim, 10e6, 0.3, 2000, 20e3, 5e3, 5, &mat));
+  else
+    CHECK(mpmc_sim_add_material_hencky(sim, 10e6, 0.3, 2000, &mat));
+  CHECK(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, np));
+  if (scene == 1) {
+    const double g[3] = {0, 0, -9.81};
+    CHECK(mpmc_sim_set_gravity(sim, g));
+    for (int f = 0; f < 6; ++f) CHECK(mpmc_sim_add_wall_face(sim, f, f == 4 ? MPMC_WALL_FIXED : MPMC_WALL_SLIP, NULL));
+  } else {
+    double *v;
+    CHECK(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+    for (int q = 0; q < *np; ++q) v[3 * q] = 0.1 * (q % 7) / 7.0; /* some deformation */
+  }
+  double dt;
+  CHECK(mpmc_sim_stable_dt(sim, 0.3, &dt));
+  for (int s = 0; s < 3; ++s) CHECK(mpmc_sim_step(sim, dt)); /* warm-up: allocations */
+  const double t0 = now();
+  for (int s = 0; s < steps; ++s) CHECK(mpmc_sim_step(sim, dt));
+  const double t = now() - t0;
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+  return (double)(*np) * steps / t;
+}
+
+int main(int argc, char **argv) {
+  const int steps = argc > 1 ? atoi(argv[1]) : 20;
+  const double scale = argc > 2 ? atof(argv[2]) : 1.0;
+  const char *bn[4] = {"linear", "ugimp", "bspline2", "bspline3"};
+  const char *fb[3] = {"off", "paper", "total"};
+  struct {
+    int scene, basis, fbar, j2;
+  } cases[] = {
+      {0, MPMC_BASIS_BSPLINE2, 0, 0}, {0, MPMC_BASIS_BSPLINE2, 1, 0},
+      {1, MPMC_BASIS_LINEAR, 0, 1},   {1, MPMC_BASIS_BSPLINE2, 0, 1},
+      {1, MPMC_BASIS_BSPLINE2, 1, 1},
+  };
+  printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s\n", "scene", "basis", "fbar", "material", "points",
+         "1 thread [M/s]", "2 threads [M/s]", "speedup");
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+    int np;
+    const double r1 = run(cases[c].scene, cases[c].basis, cases[c].fbar, cases[c].j2, 1, steps, scale, &np);
+    const double r2 = run(cases[c].scene, cases[c].basis, cases[c].fbar, cases[c].j2, 2, steps, scale, &np);
+    printf("%-7s %-9s %-5s %-10s %9d %14.3f %14.3f %8.2f\n", cases[c].scene ? "column" : "block",
+           bn[cases[c].basis], fb[cases[c].fbar], cases[c].j2 ? "hencky_j2" : "hencky", np, r1 / 1e6,
+           r2 / 1e6, r2 / r1);
+    fflush(stdout);
+  }
+  return 0;
+}

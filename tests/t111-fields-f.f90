@@ -1,0 +1,155 @@
+! Fortran twin of the field-access tests: mpmc_sim_get_field hands out x(ncomp, np) that
+! aliases the C storage (no copy) -- values written from Fortran are what the C library
+! computes with, and values the C step writes appear through the same pointer.
+program t111_fields_f
+  use, intrinsic :: iso_c_binding, only: c_int, c_double, c_loc, c_associated, c_ptr
+  use mpmc
+  implicit none
+  real(c_double), parameter :: rho = 1000.0_c_double, vol = 0.0625_c_double
+  real(c_double), parameter :: dt = 1.0e-4_c_double, vx = 1.0_c_double, vy = -2.0_c_double
+  type(mpmc_context) :: ctx
+  type(mpmc_sim) :: sim
+  integer(c_int) :: mat, first, ierr, q, sid, nsets
+  real(c_double) :: x0(2, 4), ke
+  real(c_double), pointer :: x(:, :), v(:, :), m(:), x1d(:), s(:, :)
+  integer(c_int), pointer :: ids(:), idx(:)
+  character(len=:), allocatable :: name
+  type(c_ptr) :: px
+  integer :: nfail
+
+  nfail = 0
+  x0 = reshape([1.1_c_double, 1.2_c_double, 1.6_c_double, 1.3_c_double, &
+                2.2_c_double, 2.4_c_double, 2.9_c_double, 1.8_c_double], [2, 4])
+  call ok(mpmc_context_create(ctx), 'context')
+  call ok(mpmc_sim_create(ctx, 2_c_int, sim), 'sim')
+  call ok(mpmc_sim_set_grid(sim, [0.0_c_double, 0.0_c_double], [4.0_c_double, 4.0_c_double], &
+    0.5_c_double), 'grid')
+  call ok(mpmc_sim_add_material_hencky(sim, 1.0e6_c_double, 0.3_c_double, rho, mat), 'material')
+  call ok(mpmc_sim_add_particles(sim, 4_c_int, x0, [vol, vol, vol, vol], mat, first), 'points')
+  call expect_int('first', 0, first)
+
+  ! positions: shape (dim, np), the values handed in
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, x), 'get position')
+  call expect_int('position rows', 2, size(x, 1))
+  call expect_int('position columns', 4, size(x, 2))
+  call expect_close('x(2, 3)', x0(2, 3), x(2, 3), 0.0_c_double)
+  px = c_loc(x(1, 1))
+  ! the rank-1 view starts at the same address and sees a write through the rank-2 view
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, x1d), 'get position 1d')
+  call expect_int('position 1d size', 8, size(x1d))
+  call check(same_address(px, c_loc(x1d(1))), 'rank-1 and rank-2 views share the storage')
+  x(1, 3) = 1.7_c_double
+  call expect_close('x1d(5) after writing x(1, 3)', 1.7_c_double, x1d(5), 0.0_c_double)
+  x(1, 3) = x0(1, 3)
+  call ok(mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, x1d), 'restore position 1d')
+  call check(.not. associated(x1d), 'restore nullifies the pointer')
+
+  ! mass written by C: rho * volume
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_MASS, m), 'get mass')
+  call expect_close('m(4)', rho*vol, m(4), 0.0_c_double)
+
+  ! velocities written from Fortran are what C computes the kinetic energy from
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, v), 'get velocity')
+  v(1, :) = vx
+  v(2, :) = vy
+  call ok(mpmc_sim_get_kinetic_energy(sim, ke), 'kinetic energy')
+  call expect_close('kinetic energy', 0.5_c_double*4*rho*vol*(vx**2 + vy**2), ke, 1.0e-14_c_double)
+
+  ! one step of a rigid translation: the step writes x through the pointer held across it;
+  ! partition of unity moves every point by v dt and leaves the stress zero
+  call ok(mpmc_sim_step(sim, dt), 'step')
+  do q = 1, 4
+    call expect_close('x(1, q) after a step', x0(1, q) + vx*dt, x(1, q), 1.0e-13_c_double)
+    call expect_close('x(2, q) after a step', x0(2, q) + vy*dt, x(2, q), 1.0e-13_c_double)
+  end do
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, s), 'get stress')
+  call expect_int('stress rows', 6, size(s, 1))
+  call expect_close('max |stress| of a rigid translation', 0.0_c_double, maxval(abs(s)), 1.0e-6_c_double)
+  call ok(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, v), 'restore velocity')
+  call ok(mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, x), 'restore position')
+  call check(.not. associated(x), 'restore nullifies the rank-2 pointer')
+
+  ! material ids, borrowed
+  call ok(mpmc_sim_get_material_ids(sim, ids), 'material ids')
+  call expect_int('number of ids', 4, size(ids))
+  call expect_int('ids(4)', mat, ids(4))
+
+  ! a field the scene does not have: code and message
+  ierr = mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, m)
+  call expect_int('get eps_p without a plastic material', MPMC_ERR_STATE, ierr)
+  call expect_has('message of eps_p', mpmc_context_last_error(ctx), "has no 'eps_p' field")
+  call check(.not. associated(m), 'pointer null after a failed get')
+
+  ! particle sets: names as Fortran strings, 0-based indices borrowed without a copy
+  call ok(mpmc_sim_add_particle_set(sim, 'tip', [1_c_int, 3_c_int], sid), 'add set')
+  call ok(mpmc_sim_get_num_particle_sets(sim, nsets), 'number of sets')
+  call expect_int('number of sets', 1, nsets)
+  call ok(mpmc_sim_find_particle_set(sim, 'tip', q), 'find set')
+  call expect_int('found set id', sid, q)
+  call ok(mpmc_sim_get_particle_set(sim, sid, name, idx), 'get set')
+  call check(name == 'tip' .and. len(name) == 3, 'set name "tip", got "'//name//'"')
+  call expect_int('set size', 2, size(idx))
+  call expect_int('set idx(2)', 3, idx(2))
+  ierr = mpmc_sim_add_particle_set(sim, 'bad', [7_c_int], sid)
+  call expect_int('set with an index out of range', MPMC_ERR_ARG, ierr)
+  call expect_has('message of the bad set', mpmc_context_last_error(ctx), 'idx[0] = 7 outside [0, 4)')
+
+  deallocate (name) ! main-program variables are not freed automatically
+  call ok(mpmc_sim_destroy(sim), 'destroy sim')
+  call ok(mpmc_context_destroy(ctx), 'destroy context')
+  if (nfail > 0) error stop 1
+
+contains
+
+  logical function same_address(a, b)
+    use, intrinsic :: iso_c_binding, only: c_intptr_t
+    type(c_ptr), intent(in) :: a, b
+    same_address = c_associated(a, b)
+  end function
+
+  subroutine ok(ierr, what)
+    integer(c_int), intent(in) :: ierr
+    character(*), intent(in) :: what
+    if (ierr /= MPMC_SUCCESS) then
+      write (*, '(a,a,a,i0,a,a)') 'FAILED: ', what, ' returned ', ierr, ': ', mpmc_context_last_error(ctx)
+      nfail = nfail + 1
+    end if
+  end subroutine
+
+  subroutine check(cond, what)
+    logical, intent(in) :: cond
+    character(*), intent(in) :: what
+    if (.not. cond) then
+      write (*, '(a,a)') 'FAILED: ', what
+      nfail = nfail + 1
+    end if
+  end subroutine
+
+  subroutine expect_int(what, expected, got)
+    character(*), intent(in) :: what
+    integer, intent(in) :: expected, got
+    if (expected /= got) then
+      write (*, '(a,a,a,i0,a,i0)') 'FAILED: ', what, ': expected ', expected, ', got ', got
+      nfail = nfail + 1
+    end if
+  end subroutine
+
+  subroutine expect_close(what, expected, got, tol)
+    character(*), intent(in) :: what
+    real(c_double), intent(in) :: expected, got, tol
+    if (.not. abs(got - expected) <= tol*max(1.0_c_double, abs(expected))) then
+      write (*, '(a,a,a,es24.16,a,es24.16)') 'FAILED: ', what, ': expected ', expected, ', got ', got
+      nfail = nfail + 1
+    end if
+  end subroutine
+
+  subroutine expect_has(what, text, part)
+    character(*), intent(in) :: what, text, part
+    if (index(text, part) == 0) then
+      write (*, '(a,a,a,a,a,a,a)') 'FAILED: ', what, ': expected a message containing "', part, &
+        '", got "', text, '"'
+      nfail = nfail + 1
+    end if
+  end subroutine
+
+end program t111_fields_f

@@ -1,0 +1,201 @@
+/* Bad scenes (issue 5): syntax error, wrong type, out-of-range value, unknown key, missing
+ * mesh, bad --set.  Each must fail with a non-zero code (library) and exit status (the
+ * `mpmc` program), a message naming file:line:column and the key, and write nothing over an
+ * existing output directory unless --force. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "test_util.h"
+
+#define DIR MPMC_BINARY_DIR "/t650"
+
+/* A valid scene; line numbers matter: the grid block is lines 3-6. */
+static const char *scene_fmt =
+    "dim: 2\n"                                      /* 1 */
+    "basis: bspline2\n"                             /* 2 */
+    "grid:\n"                                       /* 3 */
+    "  lo: [0, 0]\n"                                /* 4 */
+    "  hi: [2, 2]\n"                                /* 5 */
+    "  %s\n"                                        /* 6: the cell_size line */
+    "materials:\n"                                  /* 7 */
+    "  m: {model: hencky, E: 1.0e6, nu: 0.3, rho: 1000}\n" /* 8 */
+    "geometry:\n"                                   /* 9 */
+    "  - %s\n"                                      /* 10: the body */
+    "stages:\n"                                     /* 11 */
+    "  - name: fall\n"                              /* 12 */
+    "    gravity: [0, -9.81]\n"                     /* 13 */
+    "    end: {time: 0.002}\n";                     /* 14 */
+
+static const char *good_body = "{type: box, lo: [0, 0], hi: [1, 1]}";
+
+static void write_scene(const char *path, const char *cell_line, const char *body) {
+  mkdir(DIR, 0777);
+  FILE *f = fopen(path, "w");
+  assert_non_null(f);
+  fprintf(f, scene_fmt, cell_line, body);
+  fclose(f);
+}
+
+/* Run through the library; returns the code and copies the message. */
+static int run_lib(const char *scene, const char *out, int nset, const char *const *sets, int flags,
+                   char *msg, size_t len) {
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  const int e = mpmc_workflow_run(ctx, scene, out, nset, sets, flags | MPMC_WORKFLOW_QUIET);
+  snprintf(msg, len, "%s", mpmc_context_last_error(ctx));
+  mpmc_context_destroy(&ctx);
+  return e;
+}
+
+/* Run the `mpmc` program; returns its exit status and its stderr in msg. */
+static int run_cli(const char *args, char *msg, size_t len) {
+  char cmd[2048];
+  snprintf(cmd, sizeof cmd, "'%s' %s 2>&1 >/dev/null", MPMC_CLI, args);
+  FILE *p = popen(cmd, "r");
+  assert_non_null(p);
+  const size_t n = fread(msg, 1, len - 1, p);
+  msg[n] = '\0';
+  const int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static void expect_in(const char *what, const char *msg, const char *part) {
+  if (!strstr(msg, part)) fail_msg("%s: expected the message to contain \"%s\", got \"%s\"", what, part, msg);
+}
+
+static int exists(const char *p) {
+  struct stat s;
+  return stat(p, &s) == 0;
+}
+
+/* One bad scene through the library and through the program; out must stay untouched. */
+static void check_bad(const char *name, const char *cell_line, const char *body, const char *where,
+                      const char *key, const char *what) {
+  char scene[512], out[512], msg[2048], marker[600];
+  snprintf(scene, sizeof scene, DIR "/%s.yaml", name);
+  snprintf(out, sizeof out, DIR "/out-%s", name);
+  write_scene(scene, cell_line, body);
+  mkdir(out, 0777);
+  snprintf(marker, sizeof marker, "%s/keep.txt", out);
+  FILE *f = fopen(marker, "w");
+  fputs("mine", f);
+  fclose(f);
+  const int e = run_lib(scene, out, 0, NULL, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e == 0) fail_msg("%s: expected a non-zero code, got 0", name);
+  char loc[600];
+  snprintf(loc, sizeof loc, "%s.yaml:%s", name, where);
+  expect_in(name, msg, loc);
+  expect_in(name, msg, key);
+  expect_in(name, msg, what);
+  /* even with --force, a scene that does not load writes nothing */
+  char sum[600];
+  snprintf(sum, sizeof sum, "%s/summary.json", out);
+  if (exists(sum)) fail_msg("%s: expected no %s after a bad scene, found one", name, sum);
+  char args[1400];
+  snprintf(args, sizeof args, "run '%s' --out '%s' --force", scene, out);
+  const int st = run_cli(args, msg, sizeof msg);
+  if (st == 0) fail_msg("%s: expected a non-zero exit status from mpmc, got 0", name);
+  expect_in(name, msg, loc);
+  expect_in(name, msg, key);
+  if (exists(sum)) fail_msg("%s: the program wrote %s for a bad scene", name, sum);
+  if (!exists(marker)) fail_msg("%s: %s was removed", name, marker);
+}
+
+static void test_syntax_error(void **state) {
+  (void)state;
+  /* a flow list left open on line 6: libyaml reports it where the list cannot go on, at
+   * line 7, column 10 (the ':' after "materials"), while parsing grid.cell_size */
+  check_bad("syntax", "cell_size: [0.5", good_body, "7:10:", "key 'grid.cell_size", "YAML syntax error");
+}
+
+static void test_wrong_type(void **state) {
+  (void)state;
+  /* "abc" starts at line 6, column 14 */
+  check_bad("type", "cell_size: abc", good_body, "6:14:", "key 'grid.cell_size'", "expected a number (got 'abc')");
+}
+
+static void test_out_of_range(void **state) {
+  (void)state;
+  check_bad("range", "cell_size: -1", good_body, "6:14:", "key 'grid.cell_size'", "must be > 0 (got -1)");
+}
+
+static void test_unknown_key(void **state) {
+  (void)state;
+  /* the key itself is at line 6, column 3 */
+  check_bad("unknown", "cel_size: 0.5", good_body, "6:3:", "key 'grid.cel_size'", "did you mean 'cell_size'?");
+}
+
+static void test_missing_mesh(void **state) {
+  (void)state;
+  /* the file name is at line 10, column 38 ("  - " then 33 characters before it) */
+  check_bad("mesh", "cell_size: 0.5", "{type: gmsh, region: soil, file: no/such.geo}", "10:38:",
+            "key 'geometry.0.file'", "no/such.geo' not found");
+}
+
+static void test_bad_override(void **state) {
+  (void)state;
+  char scene[] = DIR "/ok.yaml", msg[2048];
+  write_scene(scene, "cell_size: 0.5", good_body);
+  const char *sets[] = {"grid.cell_size=-2"};
+  int e = run_lib(scene, DIR "/out-override", 1, sets, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set grid.cell_size=-2: expected a failure, got 0");
+  expect_in("--set", msg, "key 'grid.cell_size': must be > 0 (got -2)");
+  expect_in("--set", msg, "--set grid.cell_size=-2");
+  const char *typo[] = {"grid.cell_sise=1"};
+  e = run_lib(scene, DIR "/out-override", 1, typo, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set grid.cell_sise=1: expected a failure, got 0");
+  expect_in("--set typo", msg, "key 'grid.cell_sise': unknown key (did you mean 'cell_size'?)");
+  if (exists(DIR "/out-override")) fail_msg("a failed --set created the output directory");
+}
+
+static void test_existing_output(void **state) {
+  (void)state;
+  char scene[] = DIR "/ok.yaml", msg[2048];
+  write_scene(scene, "cell_size: 0.5", good_body);
+  const char *out = DIR "/out-existing";
+  assert_int_equal(system("rm -rf '" DIR "/out-existing'"), 0);
+  mkdir(out, 0777);
+  FILE *f = fopen(DIR "/out-existing/keep.txt", "w");
+  fputs("mine", f);
+  fclose(f);
+  int e = run_lib(scene, out, 0, NULL, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("a non-empty output directory without --force: expected a failure, got 0");
+  expect_in("existing output", msg, "exists and is not empty");
+  expect_in("existing output", msg, "--force");
+  if (exists(DIR "/out-existing/summary.json")) fail_msg("summary.json written without --force");
+  char args[600];
+  snprintf(args, sizeof args, "run '%s' --out '%s'", scene, out);
+  if (run_cli(args, msg, sizeof msg) == 0) fail_msg("mpmc run into a non-empty directory: exit status 0");
+  /* with --force the run goes ahead */
+  e = run_lib(scene, out, 0, NULL, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e) fail_msg("with --force: expected success, got %d: %s", e, msg);
+  if (!exists(DIR "/out-existing/summary.json")) fail_msg("with --force: no summary.json");
+}
+
+static void test_usage(void **state) {
+  (void)state;
+  char msg[4096];
+  if (run_cli("--help", msg, sizeof msg) != 0) fail_msg("mpmc --help: expected exit status 0");
+  if (run_cli("frobnicate x.yaml", msg, sizeof msg) == 0) fail_msg("mpmc frobnicate: expected a failure");
+  expect_in("unknown command", msg, "unknown command 'frobnicate'");
+  if (run_cli("run " DIR "/does-not-exist.yaml", msg, sizeof msg) == 0)
+    fail_msg("mpmc run on a missing file: expected a failure");
+  expect_in("missing scene", msg, "does-not-exist.yaml: cannot open the scene file");
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(test_syntax_error), cmocka_unit_test(test_wrong_type),
+      cmocka_unit_test(test_out_of_range), cmocka_unit_test(test_unknown_key),
+      cmocka_unit_test(test_missing_mesh), cmocka_unit_test(test_bad_override),
+      cmocka_unit_test(test_existing_output), cmocka_unit_test(test_usage),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
