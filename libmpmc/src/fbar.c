@@ -24,17 +24,25 @@ MPMC_ALWAYS_INLINE void scatter_impl(mpmc_sim sim, const int DIM, const int BASI
   const mpmc_particles *p = &sim->p;
   double *restrict gvol = g->vol, *restrict gjv = g->jv;
   const int total = sim->fbar == MPMC_FBAR_TOTAL;
-  for (int q = 0; q < p->n; ++q) {
-    mpmc_pw pw;
-    mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
-                       BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
-    const double dJ = det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
-    const double Vn = p->vol0[q] * p->J[q] / dJ;
-    const double val = total ? p->J[q] : p->Jbar[q] * dJ;
-    MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
-      gvol[node] += w * Vn;
-      gjv[node] += w * Vn * val;
-    });
+  /* the slabs of this step's P2G (positions unchanged since): race-free by parity */
+  const int *restrict order = sim->order, *restrict start = sim->slab_start;
+  for (int colour = 0; colour < 2; ++colour) {
+#pragma omp parallel for schedule(dynamic, 1) if (p->n > MPMC_OMP_MIN)
+    for (int sl = colour; sl < sim->nslab; sl += 2) {
+      for (int k = start[sl]; k < start[sl + 1]; ++k) {
+        const int q = order[k];
+        mpmc_pw pw;
+        mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
+                           BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+        const double dJ = det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
+        const double Vn = p->vol0[q] * p->J[q] / dJ;
+        const double val = total ? p->J[q] : p->Jbar[q] * dJ;
+        MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
+          gvol[node] += w * Vn;
+          gjv[node] += w * Vn * val;
+        });
+      }
+    }
   }
 }
 

@@ -176,9 +176,19 @@ struct mpmc_sim_s {
   double time;
   mpmc_stats stats;
   void *solver_ws;    /* return-mapping workspaces (return_map.c), per thread          */
+  /* race-free scatter (p2g.c): points bucketed into slabs of MPMC_SLAB_W cells along one
+   * axis; slabs of one colour (parity) never touch the same node, so they run in parallel */
+  int *order;         /* [n] point indices grouped by slab                             */
+  int *slab_start;    /* [nslab + 1] offsets into order                                */
+  int nslab, slab_axis, cap_order, cap_slab;
   struct mpmc_bodies_s *bodies; /* rigid bodies and barrier contact (contact_barrier.c) */
   struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
 };
+
+/* Slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic), so two
+ * slabs of the same parity, one slab apart, share no node when the width exceeds 2. */
+#define MPMC_SLAB_W 3
+int mpmc_slabs_build(struct mpmc_sim_s *sim);
 
 /* phases of one step (step.c calls them in this order) */
 int mpmc_p2g(struct mpmc_sim_s *sim, double dt);

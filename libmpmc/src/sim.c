@@ -40,6 +40,8 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   free(s->mats);
   free(s->walls);
   free(s->mirrors);
+  free(s->order);
+  free(s->slab_start);
   free(s);
   *sim = NULL;
   return MPMC_SUCCESS;
