@@ -18,64 +18,76 @@ static inline double det_dim(const int DIM, const double *F) {
                         F[2] * (F[3] * F[7] - F[4] * F[6]);
 }
 
-MPMC_ALWAYS_INLINE void scatter_impl(mpmc_sim sim, const int DIM, const int BASIS, int dummy) {
-  (void)dummy;
+/* Scatter point q: V^n and V^n j onto its nodes (Algorithm 1, step 3). */
+MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   double *restrict gvol = g->vol, *restrict gjv = g->jv;
-  const int total = sim->fbar == MPMC_FBAR_TOTAL;
-  /* the slabs of this step's P2G (positions unchanged since): race-free by parity */
-  const int *restrict order = sim->order, *restrict start = sim->slab_start;
-  for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(dynamic, 1) if (p->n > MPMC_OMP_MIN)
-    for (int sl = colour; sl < sim->nslab; sl += 2) {
-      for (int k = start[sl]; k < start[sl + 1]; ++k) {
-        const int q = order[k];
-        mpmc_pw pw;
-        mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
-                           BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
-        const double dJ = det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
-        const double Vn = p->vol0[q] * p->J[q] / dJ;
-        const double val = total ? p->J[q] : p->Jbar[q] * dJ;
-        MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
-          gvol[node] += w * Vn;
-          gjv[node] += w * Vn * val;
-        });
-      }
-    }
-  }
+  mpmc_pw pw;
+  mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
+                     BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  const double dJ = det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
+  const double Vn = p->vol0[q] * p->J[q] / dJ;
+  const double val = sim->fbar == MPMC_FBAR_TOTAL ? p->J[q] : p->Jbar[q] * dJ;
+  const double Vv = Vn * val;
+  MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
+    gvol[node] += w * Vn;
+    gjv[node] += w * Vv;
+  });
 }
 
-MPMC_ALWAYS_INLINE void gather_impl(mpmc_sim sim, const int DIM, const int BASIS, int dummy) {
-  (void)dummy;
+/* r^(1/3) for r near 1 by Newton from 1 + (r-1)/3 (three steps: relative error below 1e-16
+ * for |r - 1| < 0.05); libm's cbrt elsewhere. */
+static inline double cbrt_near1(double r) {
+  const double e = r - 1.0;
+  if (!(fabs(e) < 0.05)) return cbrt(r);
+  double x = 1.0 + e / 3.0;
+  for (int i = 0; i < 3; ++i) x -= (x * x * x - r) / (3.0 * x * x);
+  return x;
+}
+
+/* Gather point q: Pi = sum w Jbar_i, scale dF (Algorithm 1, step 4). */
+MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double *restrict gjb = g->jv;
-#pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
-  for (int q = 0; q < p->n; ++q) {
-    mpmc_pw pw;
-    mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
-                       BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
-    double pi = 0.0;
-    MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, { pi += w * gjb[node]; });
-    double *dF = p->dF + (size_t)q * DIM * DIM;
-    const double local = p->Jbar[q] * det_dim(DIM, dF);
-    const double r = pi / local;
-    const double scale = DIM == 2 ? sqrt(r) : cbrt(r);
-    for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
-    p->Jbar[q] = pi;
-  }
+  mpmc_pw pw;
+  mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
+                     BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  double pi = 0.0;
+  MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, { pi += w * gjb[node]; });
+  double *dF = p->dF + (size_t)q * DIM * DIM;
+  const double r = pi / (p->Jbar[q] * det_dim(DIM, dF));
+  const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
+  for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
+  p->Jbar[q] = pi;
 }
+
+/* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
+#define FBAR_KERNELS(D, B)                                                                   \
+  static void scatter_##D##_##B(mpmc_sim sim) {                                              \
+    const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
+    for (int colour = 0; colour < 2; ++colour) {                                             \
+      _Pragma("omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)")          \
+      for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
+        for (int k = start[sl]; k < start[sl + 1]; ++k) scatter_point(sim, D, B, order[k]);  \
+    }                                                                                        \
+  }                                                                                          \
+  static void gather_##D##_##B(mpmc_sim sim) {                                               \
+    _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
+    for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, q);                           \
+  }
+MPMC_KERNELS(FBAR_KERNELS)
 
 /** Phase 4 of the step (only with F-bar on). */
 int mpmc_fbar(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
-  MPMC_DISPATCH(scatter_impl, sim, 0);
+  MPMC_KERNEL_CALL(scatter_, sim, sim);
   /* nodal volume average (Algorithm 1 step 3) */
   const long nn = (long)g->nn;
 #pragma omp parallel for schedule(static) if (nn > MPMC_OMP_MIN)
   for (long i = 0; i < nn; ++i) g->jv[i] = g->vol[i] > 0.0 ? g->jv[i] / g->vol[i] : 0.0;
-  MPMC_DISPATCH(gather_impl, sim, 0);
+  MPMC_KERNEL_CALL(gather_, sim, sim);
   /* the projection used the weights at x^n; now the points move (eq 17) */
   double *t = sim->p.x;
   sim->p.x = sim->p.xn;

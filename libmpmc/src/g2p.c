@@ -7,56 +7,59 @@
 
 #include "transfer.h"
 
-MPMC_ALWAYS_INLINE void g2p_impl(mpmc_sim sim, const int DIM, const int BASIS, double dt,
-                                 int *bad) {
+typedef struct {
+  double eta;             /* FLIP/PIC blend                                             */
+  double *xout;           /* new positions: x, or xn while F-bar needs x^n              */
+  double xmin[3], xmax[3];/* points may drift up to one cell beyond the box (walls act on
+                             the nodes there); further out the support leaves the grid   */
+} g2p_ctx;
+
+/* Gather point q; returns 0 if its volume inverted or it left the grid. */
+MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, double dt,
+                                 const g2p_ctx *c, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double *restrict gv = g->mom, *restrict gdv = g->force;
-  const double eta = sim->flip;
-  double *restrict xout = sim->fbar ? p->xn : p->x;
-  const double *restrict lp = p->lp;
-  /* points may drift up to one cell beyond the box (walls act on the nodes there); further
-   * out, the support would leave the grid */
-  double xmin[3], xmax[3];
-  for (int a = 0; a < DIM; ++a) {
-    xmin[a] = g->lo[a] - g->h;
-    xmax[a] = g->hi[a] + g->h;
-  }
-  int first_bad = INT_MAX;
-#pragma omp parallel for schedule(static) reduction(min : first_bad) if (p->n > MPMC_OMP_MIN)
-  for (int q = 0; q < p->n; ++q) {
-    const size_t qd = (size_t)q * DIM;
-    mpmc_pw pw;
-    mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? lp[q] : 0.0, &pw);
-    double vpic[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, L[3][3] = {{0}};
-    MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
-      for (int a = 0; a < DIM; ++a) {
-        const double va = gv[node * DIM + a];
-        vpic[a] += w * va;
-        dv[a] += w * gdv[node * DIM + a];
-        for (int b = 0; b < DIM; ++b) L[a][b] += va * gw[b];
-      }
-    });
-    double *dF = p->dF + (size_t)q * DIM * DIM;
-    for (int a = 0; a < DIM; ++a)
-      for (int b = 0; b < DIM; ++b) dF[a * DIM + b] = (a == b) + dt * L[a][b];
-    const double dJ = DIM == 2 ? dF[0] * dF[3] - dF[1] * dF[2]
-                               : dF[0] * (dF[4] * dF[8] - dF[5] * dF[7]) -
-                                     dF[1] * (dF[3] * dF[8] - dF[5] * dF[6]) +
-                                     dF[2] * (dF[3] * dF[7] - dF[4] * dF[6]);
-    p->J[q] *= dJ;
-    int ok = dJ > 0.0 && isfinite(dJ);
+  const size_t qd = (size_t)q * DIM;
+  mpmc_pw pw;
+  mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  double vpic[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, L[3][3] = {{0}};
+  MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
     for (int a = 0; a < DIM; ++a) {
-      double *v = p->v + qd;
-      v[a] = eta * (v[a] + dv[a]) + (1.0 - eta) * vpic[a];
-      const double xa = p->x[qd + a] + dt * vpic[a];
-      xout[qd + a] = xa;
-      ok &= xa >= xmin[a] && xa <= xmax[a];
+      const double va = gv[node * DIM + a];
+      vpic[a] += w * va;
+      dv[a] += w * gdv[node * DIM + a];
+      for (int b = 0; b < DIM; ++b) L[a][b] += va * gw[b];
     }
-    if (!ok && q < first_bad) first_bad = q;
+  });
+  double *dF = p->dF + (size_t)q * DIM * DIM;
+  for (int a = 0; a < DIM; ++a)
+    for (int b = 0; b < DIM; ++b) dF[a * DIM + b] = (a == b) + dt * L[a][b];
+  const double dJ = DIM == 2 ? dF[0] * dF[3] - dF[1] * dF[2]
+                             : dF[0] * (dF[4] * dF[8] - dF[5] * dF[7]) -
+                                   dF[1] * (dF[3] * dF[8] - dF[5] * dF[6]) +
+                                   dF[2] * (dF[3] * dF[7] - dF[4] * dF[6]);
+  p->J[q] *= dJ;
+  int ok = dJ > 0.0 && isfinite(dJ);
+  double *v = p->v + qd;
+  for (int a = 0; a < DIM; ++a) {
+    v[a] = c->eta * (v[a] + dv[a]) + (1.0 - c->eta) * vpic[a];
+    const double xa = p->x[qd + a] + dt * vpic[a];
+    c->xout[qd + a] = xa;
+    ok &= xa >= c->xmin[a] && xa <= c->xmax[a];
   }
-  *bad = first_bad == INT_MAX ? -1 : first_bad;
+  return ok;
 }
+
+#define G2P_KERNEL(D, B)                                                                     \
+  static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {           \
+    int first_bad = INT_MAX;                                                                 \
+    _Pragma("omp parallel for schedule(static) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
+    for (int q = 0; q < sim->p.n; ++q)                                                       \
+      if (!g2p_point(sim, D, B, dt, c, q) && q < first_bad) first_bad = q;                   \
+    *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
+  }
+MPMC_KERNELS(G2P_KERNEL)
 
 static int report(mpmc_sim sim, int q) {
   const mpmc_particles *p = &sim->p;
@@ -77,8 +80,14 @@ static int report(mpmc_sim sim, int q) {
 
 /** Phase 3 of the step. */
 int mpmc_g2p(mpmc_sim sim, double dt) {
+  const mpmc_grid *g = &sim->grid;
+  g2p_ctx c = {.eta = sim->flip, .xout = sim->fbar ? sim->p.xn : sim->p.x};
+  for (int a = 0; a < sim->dim; ++a) {
+    c.xmin[a] = g->lo[a] - g->h;
+    c.xmax[a] = g->hi[a] + g->h;
+  }
   int bad = -1;
-  MPMC_DISPATCH(g2p_impl, sim, dt, &bad);
+  MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad);
   if (bad >= 0) return report(sim, bad);
   return MPMC_SUCCESS;
 }

@@ -85,21 +85,22 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS, 
   });
 }
 
-MPMC_ALWAYS_INLINE void p2g_impl(mpmc_sim sim, const int DIM, const int BASIS, int dummy) {
-  (void)dummy;
-  const int *restrict order = sim->order, *restrict start = sim->slab_start;
-  for (int colour = 0; colour < 2; ++colour) {
-#pragma omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)
-    for (int sl = colour; sl < sim->nslab; sl += 2)
-      for (int k = start[sl]; k < start[sl + 1]; ++k) p2g_point(sim, DIM, BASIS, order[k]);
+#define P2G_KERNEL(D, B)                                                                    \
+  static void p2g_##D##_##B(mpmc_sim sim) {                                                 \
+    const int *restrict order = sim->order, *restrict start = sim->slab_start;              \
+    for (int colour = 0; colour < 2; ++colour) {                                            \
+      _Pragma("omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)")         \
+      for (int sl = colour; sl < sim->nslab; sl += 2)                                       \
+        for (int k = start[sl]; k < start[sl + 1]; ++k) p2g_point(sim, D, B, order[k]);     \
+    }                                                                                       \
   }
-}
+MPMC_KERNELS(P2G_KERNEL)
 
 /** Phase 1 of the step: reset the grid and scatter the points onto it. */
 int mpmc_p2g(mpmc_sim sim, double dt) {
   (void)dt;
   mpmc_grid_clear(&sim->grid, sim->fbar);
   MPMC_CALL(mpmc_slabs_build(sim));
-  MPMC_DISPATCH(p2g_impl, sim, 0);
+  MPMC_KERNEL_CALL(p2g_, sim, sim);
   return MPMC_SUCCESS;
 }

@@ -1,6 +1,6 @@
 /* Shared pieces of the particle-grid transfers, instantiated per (dim, basis) at compile
- * time: each phase writes one always-inline body taking DIM and BASIS as constants and
- * MPMC_DISPATCH expands it once for each of the eight combinations. */
+ * time: each phase writes one always-inline per-point body taking DIM and BASIS as constants
+ * and a loop macro that MPMC_KERNELS expands once for each of the eight combinations. */
 #ifndef MPMC_TRANSFER_H
 #define MPMC_TRANSFER_H
 
@@ -53,18 +53,25 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights(const int DIM, const int BASIS, const
     }                                                                                       \
   } while (0)
 
-#define MPMC_DISPATCH(impl, sim, ...)                                    \
-  do {                                                                   \
-    switch ((sim)->dim * 4 + (sim)->basis) {                             \
-      case 8: impl(sim, 2, MPMC_BASIS_LINEAR, __VA_ARGS__); break;       \
-      case 9: impl(sim, 2, MPMC_BASIS_UGIMP, __VA_ARGS__); break;        \
-      case 10: impl(sim, 2, MPMC_BASIS_BSPLINE2, __VA_ARGS__); break;    \
-      case 11: impl(sim, 2, MPMC_BASIS_BSPLINE3, __VA_ARGS__); break;    \
-      case 12: impl(sim, 3, MPMC_BASIS_LINEAR, __VA_ARGS__); break;      \
-      case 13: impl(sim, 3, MPMC_BASIS_UGIMP, __VA_ARGS__); break;       \
-      case 14: impl(sim, 3, MPMC_BASIS_BSPLINE2, __VA_ARGS__); break;    \
-      default: impl(sim, 3, MPMC_BASIS_BSPLINE3, __VA_ARGS__); break;    \
-    }                                                                    \
+/* The eight (dim, basis) instances.  A kernel's loop, with its OpenMP pragma, is written in a
+ * macro X(D, B) expanded by MPMC_KERNELS with literal constants: GCC outlines OpenMP regions
+ * before inlining, so constants passed into a function holding the pragma would reach the
+ * outlined loop as run-time values and the basis switch would stay in the hot loop. */
+#define MPMC_KERNELS(X) X(2, 0) X(2, 1) X(2, 2) X(2, 3) X(3, 0) X(3, 1) X(3, 2) X(3, 3)
+
+/* Call fn##D##_##B(args...) for the simulation's dimension and basis. */
+#define MPMC_KERNEL_CALL(fn, sim, ...)                  \
+  do {                                                  \
+    switch ((sim)->dim * 4 + (sim)->basis) {            \
+      case 8: fn##2_0(__VA_ARGS__); break;              \
+      case 9: fn##2_1(__VA_ARGS__); break;              \
+      case 10: fn##2_2(__VA_ARGS__); break;             \
+      case 11: fn##2_3(__VA_ARGS__); break;             \
+      case 12: fn##3_0(__VA_ARGS__); break;             \
+      case 13: fn##3_1(__VA_ARGS__); break;             \
+      case 14: fn##3_2(__VA_ARGS__); break;             \
+      default: fn##3_3(__VA_ARGS__); break;             \
+    }                                                   \
   } while (0)
 
 #endif
