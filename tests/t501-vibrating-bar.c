@@ -82,6 +82,9 @@ static void check(int basis, int fbar, double tol) {
   double period, amp;
   run_bar(basis, fbar, &period, &amp);
   const double ep = fabs(period - T) / T, ea = fabs(amp - A) / A;
+  if (getenv("MPMC_TEST_VERBOSE"))
+    printf("bar basis %d fbar %d: period %.5f (error %.2f%%), tip amplitude %.5f (error %.2f%%)\n",
+           basis, fbar, period, 100 * ep, amp, 100 * ea);
   if (ep > tol || ea > tol)
     fail_msg("basis %d fbar %d: period %.5f (expected %.5f, error %.2f%%), tip amplitude %.5f "
              "(expected %.5f, error %.2f%%), tolerance %.1f%%",
