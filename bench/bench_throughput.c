@@ -11,6 +11,27 @@
 #include <time.h>
 
 #include "mpmc.h"
+#include "mpmc_impl.h"
+
+/* bytes per point held by the particle store (fields allocated for this scene, the step's
+ * scratch and the slab order; the grid excluded) */
+static double bytes_per_point(const mpmc_sim sim) {
+  const mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  struct {
+    const void *a;
+    int n;
+  } f[] = {{p->x, d},          {p->x0, d},      {p->v, d},       {p->m, 1},
+           {p->vol0, 1},       {p->J, 1},       {p->stress, 6},  {p->Jbar, 1},
+           {p->be, 6},         {p->eps_p, 1},   {p->lp, 1},      {p->force, d},
+           {p->cforce, d},     {p->ustate, p->nustate},          {p->dF, d * d},
+           {p->xn, d}};
+  double b = sizeof(int) * 2.0; /* material id, slab order */
+  for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
+    if (f[i].a) b += sizeof(double) * (double)f[i].n;
+  return b;
+}
+static double last_bytes;
 
 static double now(void) {
   struct timespec ts;
@@ -69,6 +90,7 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
   const double t0 = now();
   for (int s = 0; s < steps; ++s) CHECK(mpmc_sim_step(sim, dt));
   const double t = now() - t0;
+  last_bytes = bytes_per_point(sim);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   return (double)(*np) * steps / t;
@@ -86,15 +108,15 @@ int main(int argc, char **argv) {
       {1, MPMC_BASIS_LINEAR, 0, 1},   {1, MPMC_BASIS_BSPLINE2, 0, 1},
       {1, MPMC_BASIS_BSPLINE2, 1, 1},
   };
-  printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s\n", "scene", "basis", "fbar", "material", "points",
-         "1 thread [M/s]", "2 threads [M/s]", "speedup");
+  printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s %7s\n", "scene", "basis", "fbar", "material",
+         "points", "1 thread [M/s]", "2 threads [M/s]", "speedup", "B/point");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
     int np;
     const double r1 = run(cases[c].scene, cases[c].basis, cases[c].fbar, cases[c].j2, 1, steps, scale, &np);
     const double r2 = run(cases[c].scene, cases[c].basis, cases[c].fbar, cases[c].j2, 2, steps, scale, &np);
-    printf("%-7s %-9s %-5s %-10s %9d %14.3f %14.3f %8.2f\n", cases[c].scene ? "column" : "block",
+    printf("%-7s %-9s %-5s %-10s %9d %14.3f %14.3f %8.2f %7.0f\n", cases[c].scene ? "column" : "block",
            bn[cases[c].basis], fb[cases[c].fbar], cases[c].j2 ? "hencky_j2" : "hencky", np, r1 / 1e6,
-           r2 / 1e6, r2 / r1);
+           r2 / 1e6, r2 / r1, last_bytes);
     fflush(stdout);
   }
   return 0;
