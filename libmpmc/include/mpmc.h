@@ -192,14 +192,27 @@ int mpmc_sim_set_time(mpmc_sim sim, double t);
 int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke);
 int mpmc_sim_get_stats(const mpmc_sim sim, mpmc_stats *stats);
 
+/* ---- run monitor (monitor.c) ---------------------------------------------------------- */
+/* Every step is checked: NaN/Inf or J <= 0 (MPMC_ERR_NUMERIC), a point leaving the grid
+ * (MPMC_ERR_OUTSIDE), and kinetic energy growing without input (MPMC_ERR_UNSTABLE): E_k
+ * above factor x the energy available since the last change of inputs (E_k + elastic
+ * energy then, plus the work of gravity and of the point loads since; rigid bodies and user
+ * materials switch this check off).  The message names the step, the point, its position
+ * and the cause.
+ * factor > 1 (default 10); 0 restores the default; < 0 turns the energy check off.  Every
+ * call starts a new baseline: call it after writing velocities or stresses in place. */
+#define MPMC_MONITOR_ENERGY_FACTOR 10.0
+int mpmc_sim_set_energy_monitor(mpmc_sim sim, double factor);
+
 /* ---- rigid bodies and contact (contact_barrier.c) ------------------------------------ */
 /* Rigid bodies (axis-aligned boxes in 2D/3D, simple polygons in 2D) move with a prescribed
  * velocity and push the material points through the IPC barrier on the gap d between a
  * point and the body's surface:  f = A_p kappa (d - dhat)[2 ln(d/dhat) + 1 - dhat/d] n for
  * 0 < d < dhat (A_p = V0^((dim-1)/dim), n the body's outward normal), with Coulomb friction
- * mu smoothed near zero slip.  The explicit time step accounts for the barrier stiffness
- * (mpmc_sim_stable_dt); a step after which a point lies inside a body fails with
- * MPMC_ERR_NUMERIC.  Defaults of dhat and kappa: docs/contact.md. */
+ * mu as an elastic stick (a spring on the slip since the point stuck, capped at mu times the
+ * normal force; bodies and anchors are saved in checkpoints).  The explicit time step
+ * accounts for the barrier stiffness (mpmc_sim_stable_dt); a step after which a point lies
+ * inside a body fails with MPMC_ERR_NUMERIC.  Defaults of dhat and kappa: docs/contact.md. */
 int mpmc_sim_add_rigid_box(mpmc_sim sim, const double *lo, const double *hi, double mu, int *id);
 /* 2D only: nvert vertices xy[2*nvert], either orientation. */
 int mpmc_sim_add_rigid_polygon(mpmc_sim sim, int nvert, const double *xy, double mu, int *id);

@@ -6,9 +6,9 @@
  *
  * The file is a list of blocks; each block is a writer and a reader below and one line in
  * `blocks`.  Not saved: user-material functions (the caller re-attaches them with
- * mpmc_sim_set_material_user_fn), rigid bodies (a sim with bodies refuses to checkpoint
- * until contact_barrier.c gets a block), and scratch arrays (dF, xn, grid arrays) that
- * every step recomputes. */
+ * mpmc_sim_set_material_user_fn) and scratch arrays (dF, xn, grid arrays) that every step
+ * recomputes.  Rigid bodies (contact.h) are saved with their motion, last reaction and
+ * friction anchors. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -16,6 +16,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "contact.h"
 #include "io.h"
 #include "sets.h"
 
@@ -426,6 +427,158 @@ static int read_sets(hid_t f, mpmc_sim sim) {
   return err;
 }
 
+/* ---- block: rigid bodies (contact_barrier.c) ---------------------------------------------- */
+
+/* One row per body: active kind mu nvert lo[3] hi[3] v[3] offset[3] reaction[3]; the polygons'
+ * vertices concatenated in /bodies/vertices [sum nvert][2].  "present" records whether the
+ * sim had a contact record at all (mpmc_sim_set_contact_params alone creates one), so that a
+ * restart zeroes p->cforce on the same steps as the uninterrupted run. */
+#define BODYCOLS 19
+
+static int write_bodies(hid_t f, const mpmc_sim sim) {
+  const struct mpmc_bodies_s *B = sim->bodies;
+  const int present = B != NULL, nb = B ? B->n : 0;
+  const double par[2] = {B ? B->dhat : 0.0, B ? B->kappa : 0.0};
+  int nv = 0;
+  for (int i = 0; i < nb; ++i) nv += B->b[i].kind == BODY_POLYGON ? B->b[i].nvert : 0;
+  double *rows = malloc(sizeof(double) * BODYCOLS * (size_t)(nb > 0 ? nb : 1));
+  double *xy = malloc(sizeof(double) * 2 * (size_t)(nv > 0 ? nv : 1));
+  hid_t g = rows && xy ? H5Gcreate2(f, "bodies", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT) : -1;
+  herr_t st = g < 0 ? -1 : 0;
+  for (int i = 0, k = 0; i < nb && st >= 0; ++i) {
+    const mpmc_body *b = &B->b[i];
+    double *r = rows + (size_t)i * BODYCOLS;
+    r[0] = b->active, r[1] = b->kind, r[2] = b->mu, r[3] = b->kind == BODY_POLYGON ? b->nvert : 0;
+    for (int a = 0; a < 3; ++a) {
+      r[4 + a] = b->lo[a], r[7 + a] = b->hi[a], r[10 + a] = b->v[a];
+      r[13 + a] = b->offset[a], r[16 + a] = b->reaction[a];
+    }
+    if (b->kind == BODY_POLYGON) {
+      memcpy(xy + 2 * (size_t)k, b->xy, sizeof(double) * 2 * (size_t)b->nvert);
+      k += b->nvert;
+    }
+  }
+  if (st >= 0) {
+    st |= mpmc_h5_attr_write(g, "present", H5T_NATIVE_INT, 1, &present);
+    st |= mpmc_h5_attr_write(g, "dhat_kappa", H5T_NATIVE_DOUBLE, 2, par);
+    st |= mpmc_h5_dataset_write(g, "bodies", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)nb,
+                                BODYCOLS, rows);
+    st |= mpmc_h5_dataset_write(g, "vertices", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)nv, 2,
+                                xy);
+    st |= mpmc_h5_attr_write_string(
+        g, "bodies_columns", "active kind mu nvert lo[3] hi[3] v[3] offset[3] reaction[3]");
+  }
+  for (int i = 0; i < nb && st >= 0; ++i) /* friction anchors (elastic stick) */
+    if (B->b[i].anchor) {
+      char name[32];
+      snprintf(name, sizeof name, "anchor%d", i);
+      st |= mpmc_h5_dataset_write(g, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                                  (size_t)B->b[i].nanchor, 3, B->b[i].anchor);
+    }
+  if (g >= 0) H5Gclose(g);
+  free(rows);
+  free(xy);
+  return st < 0 ? -1 : 0;
+}
+
+/* Dataset rows of `name` in g ([rows][cols]); -1 if absent or of another width. */
+static long dataset_rows(hid_t g, const char *name, hsize_t cols) {
+  hid_t ds = exists(g, name) ? H5Dopen2(g, name, H5P_DEFAULT) : -1;
+  if (ds < 0) return -1;
+  hid_t sp = H5Dget_space(ds);
+  hsize_t dims[2] = {0, 0};
+  const int rank = sp >= 0 ? H5Sget_simple_extent_dims(sp, dims, NULL) : -1;
+  if (sp >= 0) H5Sclose(sp);
+  H5Dclose(ds);
+  return rank == 2 && dims[1] == cols && dims[0] < 1000000 ? (long)dims[0] : -1;
+}
+
+/* A checkpoint without the group (written before bodies were saved) has no bodies. */
+static int read_bodies(hid_t f, mpmc_sim sim) {
+  mpmc_context ctx = sim->ctx;
+  if (!exists(f, "bodies")) return MPMC_SUCCESS;
+  hid_t g = H5Gopen2(f, "bodies", H5P_DEFAULT);
+  MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint /bodies: cannot open the group");
+  int present = 0, err = MPMC_SUCCESS;
+  double par[2] = {0, 0};
+  const long nb = dataset_rows(g, "bodies", BODYCOLS), nv = dataset_rows(g, "vertices", 2);
+  double *rows = NULL, *xy = NULL;
+  if (mpmc_h5_attr_read(g, "present", H5T_NATIVE_INT, 1, &present) < 0 ||
+      mpmc_h5_attr_read(g, "dhat_kappa", H5T_NATIVE_DOUBLE, 2, par) < 0 || nb < 0 || nv < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
+                     "checkpoint /bodies: attributes present/dhat_kappa or datasets bodies "
+                     "[n][%d] / vertices [n][2] missing",
+                     BODYCOLS);
+  if (!err) {
+    rows = malloc(sizeof(double) * BODYCOLS * (size_t)(nb > 0 ? nb : 1));
+    xy = malloc(sizeof(double) * 2 * (size_t)(nv > 0 ? nv : 1));
+    if (!rows || !xy) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "cannot allocate %ld bodies", nb);
+  }
+  if (!err && (read_dataset(g, "bodies", H5T_NATIVE_DOUBLE, (size_t)nb, BODYCOLS, rows) < 0 ||
+               read_dataset(g, "vertices", H5T_NATIVE_DOUBLE, (size_t)nv, 2, xy) < 0))
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /bodies: datasets unreadable");
+  if (!err && present) {
+    sim->bodies = calloc(1, sizeof *sim->bodies);
+    if (sim->bodies) sim->bodies->b = calloc((size_t)(nb > 0 ? nb : 1), sizeof(mpmc_body));
+    if (!sim->bodies || !sim->bodies->b)
+      err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "cannot allocate %ld rigid bodies", nb);
+    else {
+      sim->bodies->cap = nb > 0 ? (int)nb : 1;
+      sim->bodies->dhat = par[0];
+      sim->bodies->kappa = par[1];
+    }
+  }
+  long k = 0;
+  for (long i = 0; i < nb && !err && present; ++i) {
+    const double *r = rows + (size_t)i * BODYCOLS;
+    mpmc_body *b = &sim->bodies->b[i];
+    b->active = (int)r[0], b->kind = (int)r[1], b->mu = r[2], b->nvert = (int)r[3];
+    for (int a = 0; a < 3; ++a) {
+      b->lo[a] = r[4 + a], b->hi[a] = r[7 + a], b->v[a] = r[10 + a];
+      b->offset[a] = r[13 + a], b->reaction[a] = r[16 + a];
+    }
+    if (b->kind != BODY_BOX && !(b->kind == BODY_POLYGON && sim->dim == 2 && b->nvert >= 3 &&
+                                 k + b->nvert <= nv)) {
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
+                       "checkpoint rigid body %ld: kind %d with %d vertices (%ld stored) is "
+                       "not a box or a 2D polygon",
+                       i, b->kind, b->nvert, nv - k);
+      break;
+    }
+    if (b->kind == BODY_POLYGON) {
+      b->xy = malloc(sizeof(double) * 2 * (size_t)b->nvert);
+      if (!b->xy) {
+        err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "cannot allocate polygon %ld", i);
+        break;
+      }
+      memcpy(b->xy, xy + 2 * (size_t)k, sizeof(double) * 2 * (size_t)b->nvert);
+      k += b->nvert;
+    } else {
+      b->nvert = 0;
+    }
+    sim->bodies->n = (int)i + 1; /* mpmc_contact_free releases what was read so far */
+    char aname[32];
+    snprintf(aname, sizeof aname, "anchor%ld", i);
+    const long na = dataset_rows(g, aname, 3);
+    if (exists(g, aname) && na < 0) {
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /bodies/%s is not [n][3]", aname);
+      break;
+    }
+    if (na > 0) {
+      b->anchor = malloc(sizeof(double) * 3 * (size_t)na);
+      if (!b->anchor || read_dataset(g, aname, H5T_NATIVE_DOUBLE, (size_t)na, 3, b->anchor) < 0) {
+        err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /bodies/%s: unreadable", aname);
+        break;
+      }
+      b->nanchor = (int)na;
+    }
+  }
+  H5Gclose(g);
+  free(rows);
+  free(xy);
+  return err;
+}
+
 /* ---- the file ------------------------------------------------------------------------------ */
 
 typedef struct {
@@ -439,7 +592,8 @@ static const block blocks[] = {{"config", write_config, read_config},
                                {"materials", write_materials, read_materials},
                                {"particles", write_particles, read_particles},
                                {"walls", write_walls, read_walls},
-                               {"sets", write_sets, read_sets}};
+                               {"sets", write_sets, read_sets},
+                               {"bodies", write_bodies, read_bodies}};
 #define NBLOCK (sizeof blocks / sizeof blocks[0])
 
 /**
@@ -453,8 +607,6 @@ int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "checkpoint: no grid set, nothing to save");
-  MPMC_CHECK(!sim->bodies, ctx, MPMC_ERR_UNSUPPORTED,
-             "checkpoint: rigid bodies cannot be saved yet; '%s' not written", path);
   const size_t len = strlen(path) + 5;
   char *tmp = malloc(len);
   MPMC_CHECK(tmp, ctx, MPMC_ERR_MEMORY, "cannot allocate a path");

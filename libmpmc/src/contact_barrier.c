@@ -8,18 +8,18 @@
  * d the signed distance of point p to the body's surface, n the body's outward normal at the
  * closest point, A_p = V0_p^((dim-1)/dim) the point's tributary contact area (a length per
  * unit thickness in 2D), so kappa is a stiffness per area per length [Pa/m] and
- * kappa dhat g(x) the contact pressure.  Coulomb friction is smoothed by IPC's f1
- * mollifier in the relative tangential velocity.  The forces go to p->cforce, which P2G adds
- * to the external force; the body's reaction is minus their sum.  docs/contact.md derives
- * the defaults of dhat and kappa and the time-step limit. */
+ * kappa dhat g(x) the contact pressure.  Coulomb friction is an elastic stick: a spring
+ * and damper on the point's tangential displacement since it stuck, capped at mu times the
+ * normal force (then it slides and the anchor follows).  The forces go to p->cforce, which
+ * P2G adds to the external force; the body's reaction is minus their sum.  docs/contact.md
+ * derives the defaults of dhat and kappa, the time-step limit and the friction law. */
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact.h"
 #include "mpmc_impl.h"
-
-enum { BODY_BOX = 0, BODY_POLYGON = 1 };
 
 /* the gap ratio x = d/dhat at which the default kappa makes the barrier's time-step limit
  * equal to the material's h/c */
@@ -28,23 +28,6 @@ enum { BODY_BOX = 0, BODY_POLYGON = 1 };
 #define CONTACT_X_FLOOR 1e-6
 /* below this many points the loops run on one thread (a parallel region costs more) */
 #define CONTACT_PAR_MIN 4096
-
-typedef struct {
-  int active, kind;
-  double lo[3], hi[3]; /* the box, or the polygon's bounding box, at creation          */
-  int nvert;
-  double *xy;          /* polygon vertices [nvert][2] at creation, counter-clockwise   */
-  double mu;           /* Coulomb friction coefficient                                  */
-  double v[3];         /* prescribed velocity                                           */
-  double offset[3];    /* displacement since creation                                   */
-  double reaction[3];  /* force of the points on the body in the last step              */
-} mpmc_body;
-
-struct mpmc_bodies_s {
-  mpmc_body *b;
-  int n, cap;
-  double dhat, kappa; /* the caller's values; 0 = derive (docs/contact.md)          */
-};
 
 /* ---- the barrier ---------------------------------------------------------------------- */
 /* Pressure per kappa*dhat: g(x) = (x - 1)(2 ln x + 1 - 1/x) = -b'(d)/dhat, x = d/dhat. */
@@ -177,11 +160,18 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
   for (long i = 0; i < nd; ++i) cf[i] = 0.0;
   double dhat, kappa;
   contact_params(sim, &dhat, &kappa);
-  const double eps_floor = 1e-3 * dhat / dt; /* slip per step below 1e-3 dhat is "stuck" */
   for (int bi = 0; bi < B->n; ++bi) {
     mpmc_body *b = &B->b[bi];
     if (!b->active) continue;
     const double mu = b->mu;
+    if (mu > 0.0 && b->nanchor < p->n) { /* anchors of new points start at rest */
+      double *a = realloc(b->anchor, sizeof *a * 3 * (size_t)p->n);
+      MPMC_CHECK(a, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate friction anchors of %d points", p->n);
+      for (size_t i = 3 * (size_t)b->nanchor; i < 3 * (size_t)p->n; ++i) a[i] = NAN;
+      b->anchor = a;
+      b->nanchor = p->n;
+    }
+    double *restrict anc = mu > 0.0 ? b->anchor : NULL;
     const double vb[3] = {b->v[0], b->v[1], b->v[2]};
     double r0 = 0.0, r1 = 0.0, r2 = 0.0;
     int bad = INT_MAX;
@@ -189,36 +179,57 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
     if (p->n > CONTACT_PAR_MIN)
     for (int q = 0; q < p->n; ++q) {
       const double *x = p->x + (size_t)q * d;
-      if (far_from(b, d, x, dhat)) continue;
+      double *u = anc ? anc + 3 * (size_t)q : NULL; /* out of contact: no anchor (NaN) */
+      if (far_from(b, d, x, dhat)) {
+        if (u) u[0] = NAN;
+        continue;
+      }
       double n[3] = {0, 0, 0};
       const double gap = body_gap(b, d, x, n);
       if (!(gap > 0.0)) {
         if (q < bad) bad = q;
         continue;
       }
-      if (gap >= dhat) continue;
+      if (gap >= dhat) {
+        if (u) u[0] = NAN;
+        continue;
+      }
       /* normal force (paper's barrier, formulas.md) */
       const double lam = point_area(d, p->vol0[q]) * kappa * dhat * barrier_g(gap / dhat);
       double f[3] = {0, 0, 0};
       for (int a = 0; a < d; ++a) f[a] = lam * n[a];
-      if (mu > 0.0) {
-        /* smoothed Coulomb friction (IPC f1): |f_t| = mu lam f1(s/eps), s = |v_t|.  Its
-         * damping slope 2 mu lam / eps is kept below m/dt so that it stays stable in the
-         * explicit step (docs/contact.md). */
+      if (u) {
+        /* Coulomb friction as an elastic stick (docs/contact.md): the anchor u is where the
+         * point stuck, in the body's frame; the trial force -k s - c v_t on the tangential
+         * offset s from it (k = m/(4 dt^2), c = m/(2 dt): stable in the explicit step; a
+         * steady tangential load T leaves a fixed offset T/k instead of a slip rate) is
+         * capped at mu lam, where the point slides and the anchor is dragged along. */
         const double *v = p->v + (size_t)q * d;
-        double vt[3], vn = 0.0, s2 = 0.0;
-        for (int a = 0; a < d; ++a) vn += (v[a] - vb[a]) * n[a];
+        const double k = 0.25 * p->m[q] / (dt * dt), c = 0.5 * p->m[q] / dt;
+        double xb[3] = {0, 0, 0}, st[3] = {0, 0, 0}, vt[3] = {0, 0, 0}, ft[3] = {0, 0, 0};
+        double vn = 0.0, sn = 0.0, f2 = 0.0;
+        for (int a = 0; a < d; ++a) xb[a] = x[a] - b->offset[a];
+        if (isnan(u[0]))
+          for (int a = 0; a < d; ++a) u[a] = xb[a];
+        for (int a = 0; a < d; ++a) {
+          vn += (v[a] - vb[a]) * n[a];
+          sn += (xb[a] - u[a]) * n[a];
+        }
         for (int a = 0; a < d; ++a) {
           vt[a] = v[a] - vb[a] - vn * n[a];
-          s2 += vt[a] * vt[a];
+          st[a] = xb[a] - u[a] - sn * n[a];
+          ft[a] = -k * st[a] - c * vt[a];
+          f2 += ft[a] * ft[a];
         }
-        if (s2 > 0.0) {
-          const double s = sqrt(s2);
-          double eps = 2.0 * mu * lam * dt / p->m[q];
-          if (eps < eps_floor) eps = eps_floor;
-          const double y = s / eps, f1 = y < 1.0 ? y * (2.0 - y) : 1.0;
-          for (int a = 0; a < d; ++a) f[a] -= mu * lam * f1 * vt[a] / s;
+        const double fmax = mu * lam;
+        if (f2 > fmax * fmax) { /* sliding: the anchor follows so that the spring holds mu lam */
+          const double sc = fmax / sqrt(f2);
+          for (int a = 0; a < d; ++a) {
+            ft[a] *= sc;
+            u[a] = xb[a] - sn * n[a] + ft[a] / k;
+          }
         }
+        for (int a = 0; a < d; ++a) f[a] += ft[a];
       }
       double *c = cf + (size_t)q * d;
       for (int a = 0; a < d; ++a) c[a] += f[a];
@@ -332,7 +343,10 @@ double mpmc_contact_stable_dt(const struct mpmc_sim_s *sim) {
 void mpmc_contact_free(struct mpmc_sim_s *sim) {
   struct mpmc_bodies_s *B = sim->bodies;
   if (!B) return;
-  for (int i = 0; i < B->n; ++i) free(B->b[i].xy);
+  for (int i = 0; i < B->n; ++i) {
+    free(B->b[i].xy);
+    free(B->b[i].anchor);
+  }
   free(B->b);
   free(B);
   sim->bodies = NULL;

@@ -151,6 +151,23 @@ typedef struct {
   unsigned odd;          /* bit a: component a is reflected with a sign change */
 } mpmc_mirror;
 
+/* ---- run monitor (monitor.c) --------------------------------------------------------- */
+/* State of the energy check: the energy at a baseline and the work the external forces have
+ * done since, and a signature of the inputs (gravity, walls, strengths, points, loads) that
+ * starts a new baseline when it changes.  Zero-initialised with the sim (factor 0: default). */
+typedef struct {
+  double factor;       /* stop when E_k > factor * available; < 0: energy check off      */
+  int64_t base_step;   /* step of the baseline; 0: none yet                              */
+  double e0[2];        /* kinetic and elastic energy at the baseline [J]                 */
+  double gx0, fx0;     /* sum m g.x and sum f.x at the baseline (work = their change)    */
+  double sig[8];       /* input signature at the baseline                                */
+  double ke_last;      /* kinetic energy at the last check                               */
+  int64_t next_check;  /* step of the next velocity pass                                 */
+} mpmc_monitor;
+/* After each step: NaN/Inf velocity and kinetic energy above the energy available
+ * (MPMC_ERR_UNSTABLE). */
+int mpmc_monitor_step(struct mpmc_sim_s *sim);
+
 /* ---- the simulation ---------------------------------------------------------------- */
 struct mpmc_sim_s {
   mpmc_context ctx;
@@ -183,6 +200,7 @@ struct mpmc_sim_s {
   int nslab, slab_axis, cap_order, cap_slab;
   struct mpmc_bodies_s *bodies; /* rigid bodies and barrier contact (contact_barrier.c) */
   struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
+  mpmc_monitor monitor;         /* energy check after each step (monitor.c)           */
 };
 
 /* Slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic), so two

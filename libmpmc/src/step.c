@@ -21,6 +21,7 @@ static int step_phases(mpmc_sim sim, double dt) {
   if (sim->fbar) MPMC_CALL(mpmc_fbar(sim)); /* dF -> dF-bar             (Alg. 1, 2-4)  */
   MPMC_CALL(mpmc_stress_update(sim, dt)); /* material update with dF(-bar)             */
   if (sim->bodies) MPMC_CALL(mpmc_contact_check(sim)); /* no point inside a rigid body */
+  MPMC_CALL(mpmc_monitor_step(sim)); /* NaN velocity, energy growth (monitor.c)         */
   return MPMC_SUCCESS;
 }
 

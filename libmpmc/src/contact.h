@@ -1,0 +1,27 @@
+/* Rigid bodies of contact_barrier.c, shared with checkpoint.c (which saves them). */
+#ifndef MPMC_CONTACT_H
+#define MPMC_CONTACT_H
+
+enum { BODY_BOX = 0, BODY_POLYGON = 1 };
+
+typedef struct {
+  int active, kind;
+  double lo[3], hi[3]; /* the box, or the polygon's bounding box, at creation          */
+  int nvert;
+  double *xy;          /* polygon vertices [nvert][2] at creation, counter-clockwise   */
+  double mu;           /* Coulomb friction coefficient                                  */
+  double v[3];         /* prescribed velocity                                           */
+  double offset[3];    /* displacement since creation                                   */
+  double reaction[3];  /* force of the points on the body in the last step              */
+  int nanchor;         /* points the anchors cover (grown with the point count)         */
+  double *anchor;      /* friction: per point [nanchor][3] tangential displacement since
+                        * it stuck (elastic stick, docs/contact.md); NULL until mu > 0 */
+} mpmc_body;
+
+struct mpmc_bodies_s {
+  mpmc_body *b;
+  int n, cap;
+  double dhat, kappa; /* the caller's values; 0 = derive (docs/contact.md)          */
+};
+
+#endif
