@@ -73,6 +73,19 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
   return fclose(f) ? -1 : 0;
 }
 
+/* bearing.png: q/su against delta/B from series.csv with Prandtl's 2 + pi (rigid.c) */
+static void plot_bearing(FILE *g, const wf_scene *sc) {
+  int col = 7;
+  for (int k = 0; k < WF_METRIC_SETTLEMENT_B; ++k) col += sc->metrics.enabled[k];
+  fprintf(g, "set output 'bearing.png'\nset xlabel 'settlement delta / B'\nset ylabel 'q / su' noenhanced\n"
+             "set title '%s: load-settlement curve of the footing' noenhanced\nset key bottom right\n"
+             "set yrange [0:*]\n", sc->name);
+  fprintf(g, "plot 'series.csv' skip 1 using %d:%d with linespoints lw 2 pt 7 ps 0.4 title 'q/su (mean over each row)', "
+             "2 + pi with lines dt 2 lw 2 lc rgb 'black' title 'Prandtl: 2 + pi = 5.14'\n",
+          col, col + 1);
+  fprintf(g, "set autoscale y\nset key default\n"); /* leave the settings as found */
+}
+
 /** @brief Write final_state.csv and the PNG plots into outdir. */
 int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *warn, size_t len) {
   const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
@@ -142,6 +155,7 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
   }
   if (!any) fprintf(g, "plot 'series.csv' skip 1 using 2:6 with lines lw 2 title 'E_k / E_k,max'");
   fprintf(g, "\nunset multiplot\n");
+  if (sc->metrics.enabled[WF_METRIC_BEARING]) plot_bearing(g, sc);
   const int st = pclose(g);
   if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
     snprintf(warn, len, "gnuplot failed (see %s/plots.log)", outdir);

@@ -13,7 +13,43 @@
 #include "wf.h"
 
 const char *const wf_metric_names[WF_METRIC_COUNT] = {"runout_distance", "tip_displacement_y",
-                                                      "tip_displacement_x", "center_of_mass_x"};
+                                                      "tip_displacement_x", "center_of_mass_x",
+                                                      "settlement_over_B", "q_over_su",
+                                                      "bearing_capacity_ratio",
+                                                      [WF_METRIC_FRONT_X] = "surge_front_x",
+                                                      [WF_METRIC_HYDRO] = "hydrostatic_pressure_error"};
+
+/* Hydrostatic pressure error (dam break, paper section 4.3): with p = -tr(sigma)/3 and the
+ * reference p_ref = rho g (surface - x_v) (rho = mass / initial volume, x_v the coordinate
+ * along gravity), sqrt(sum (p - p_ref)^2 / sum p_ref^2) over the material points. */
+static double hydro_error(mpmc_sim sim, const wf_scene *sc) {
+  const wf_metrics *m = &sc->metrics;
+  double *x, *mass, *vol0, *sig;
+  int np;
+  mpmc_sim_get_num_particles(sim, &np);
+  if (mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) || mpmc_sim_get_field(sim, MPMC_FIELD_MASS, &mass, NULL) ||
+      mpmc_sim_get_field(sim, MPMC_FIELD_VOLUME0, &vol0, NULL) || mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
+    return NAN;
+  double num = 0, den = 0;
+  for (int q = 0; q < np; ++q) {
+    const double depth = fmax(0.0, m->surface - x[(size_t)q * sc->dim + m->hydro_axis]);
+    const double pref = mass[q] / vol0[q] * m->hydro_g * depth;
+    const double p = -(sig[(size_t)q * 6] + sig[(size_t)q * 6 + 1] + sig[(size_t)q * 6 + 2]) / 3.0;
+    num += (p - pref) * (p - pref);
+    den += pref * pref;
+  }
+  return den > 0 ? sqrt(num / den) : NAN;
+}
+
+/** @brief Keep the metrics defined at the end of a stage (hydrostatic_pressure_error). */
+int wf_metrics_stage_end(mpmc_sim sim, wf_scene *sc, int stage) {
+  wf_metrics *m = &sc->metrics;
+  if (m->enabled[WF_METRIC_HYDRO] && m->hydro_stage == stage) {
+    m->hydro_value = hydro_error(sim, sc);
+    m->hydro_frozen = 1;
+  }
+  return 0;
+}
 
 /** @brief Resolve the toe and the tracked point from the initial positions. */
 int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
@@ -71,6 +107,14 @@ int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *v) {
     }
     v[WF_METRIC_COM_X] = mt > 0 ? mx / mt : NAN;
   }
+  if (m->enabled[WF_METRIC_FRONT_X]) { /* the surge front: the farthest point along x */
+    double front = -INFINITY;
+    for (int q = 0; q < np; ++q) front = fmax(front, x[(size_t)q * d]);
+    v[WF_METRIC_FRONT_X] = front;
+  }
+  if (m->enabled[WF_METRIC_HYDRO]) v[WF_METRIC_HYDRO] = m->hydro_frozen ? m->hydro_value : hydro_error(sim, sc);
+  if (m->enabled[WF_METRIC_BEARING]) /* rigid.c: q/su averaged since the last series row */
+    wf_bearing_values(sc, 1, &v[WF_METRIC_SETTLEMENT_B], &v[WF_METRIC_Q_SU], &v[WF_METRIC_BEARING]);
   return 0;
 }
 

@@ -49,6 +49,9 @@ typedef struct {
   const char *const *overrides;
   double strength;         /* the strength reduction factor in force (1: as given)        */
   int saved_threads;       /* OpenMP threads before the run (0: unchanged)                 */
+  int ckpt_ok;             /* a checkpoint (the last good state) has been written           */
+  double ckpt_time;        /* its simulated time                                          */
+  int resumed;             /* outputs are the _resumed files                              */
 } wf_run;
 
 /* `threads` applies to every parallel region of the run (the step and the reductions the
@@ -184,6 +187,11 @@ static int build(wf_run *w) {
       mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v);
     }
   }
+  {
+    char msg[WF_MSG] = "";
+    const int e = wf_rigid_build(sim, sc, msg, sizeof msg);
+    if (e) return fail(w, e, "%s: %s", msg, mpmc_context_last_error(w->ctx));
+  }
   WF_TRY(w, wf_metrics_init(sim, sc), "metrics");
   return 0;
 }
@@ -216,7 +224,7 @@ static void log_plan(const wf_run *w) {
   FEATURE(walls > 0, "walls");
   FEATURE(tractions, "tractions");
   FEATURE(srf, "strength reduction");
-  FEATURE(0, "rigid-body contact");
+  FEATURE(sc->nrigid > 0, "rigid-body contact");
 #ifdef MPMC_WF_HAVE_CHECKPOINT
   FEATURE(1, "checkpoints");
 #else
@@ -261,6 +269,7 @@ static int stage_setup(wf_run *w, int i) {
   mpmc_sim sim = w->sim;
   if (s->has_gravity) WF_TRY(w, mpmc_sim_set_gravity(sim, s->gravity), "stages.%d.gravity", i);
   WF_TRY(w, mpmc_sim_set_damping(sim, s->damping), "stages.%d.damping", i);
+  WF_TRY(w, mpmc_sim_set_force_dt(sim, s->force_dt), "stages.%d.force_dt", i);
   int base = 0;
   for (int j = 0; j < i; ++j) base += sc->stages[j].nwalls;
   for (int k = 0; k < s->nwalls; ++k) {
@@ -350,7 +359,9 @@ static int series_row(wf_run *w, int stage, long step, double dt, double ke, dou
   for (int k = 0; k < WF_METRIC_COUNT; ++k)
     if (w->sc.metrics.enabled[k]) fprintf(w->series, ",%.9g", m[k]);
   fputc('\n', w->series);
-  fflush(w->series);
+  /* a full disk shows here first: stop with the reason instead of a silently short series */
+  if (fflush(w->series) || ferror(w->series))
+    return fail(w, MPMC_ERR_IO, "cannot write %s/series.csv: %s", w->out, strerror(errno));
   return 0;
 }
 
@@ -378,9 +389,32 @@ static int checkpoint(wf_run *w, int stage, double t_stage, long steps, double k
                           w->rec[i].steps, w->rec[i].wall_seconds, w->rec[i].reason);
   if (l >= sizeof meta) return fail(w, MPMC_ERR_MEMORY, "checkpoint: too many overrides to record");
   WF_TRY(w, mpmc_sim_checkpoint_write(w->sim, path, meta), "checkpoint %s", path);
+  w->ckpt_ok = 1;
+  mpmc_sim_get_time(w->sim, &w->ckpt_time);
   return 0;
 }
 #endif
+
+/* A step failed (the monitor's energy check, NaN, J <= 0, a point leaving the grid, a dt
+ * above the limit): the state in memory is the failing one.  The last good state is the
+ * newest checkpoint.h5 (written at the start, at every stage end and every
+ * checkpoint_interval), left untouched; copying the state before every step instead would
+ * cost a full copy of the particles per step.  The failing state is appended to the
+ * snapshots for inspection. */
+static int step_failed(wf_run *w, int e, const wf_stage *s, double t, long steps) {
+  char lib[MPMC_MSG_LEN], note[2 * WF_PATH + 256] = "";
+  snprintf(lib, sizeof lib, "%s", mpmc_context_last_error(w->ctx));
+  if (w->ckpt_ok)
+    snprintf(note, sizeof note,
+             "; last good state: %s/checkpoint.h5 (t = %.6g s): change the scene (e.g. dt_factor) and "
+             "run `mpmc resume %s`",
+             w->out, w->ckpt_time, w->out);
+  const size_t l = strlen(note);
+  if (w->snap && mpmc_output_write(w->snap) == 0)
+    snprintf(note + l, sizeof note - l, "; the failing state is the last snapshot in %s/snapshots%s.h5", w->out,
+             w->resumed ? "_resumed" : "");
+  return fail(w, e, "stage '%s' at t = %.6g s (step %ld): %s%s", s->name, t, steps, lib, note);
+}
 
 /* Run stage i from t_stage (0 unless resuming). */
 static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_max, wf_progress *pr) {
@@ -402,18 +436,29 @@ static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_m
   const char *reason = NULL;
   long s0 = steps;
   (void)last_ckpt;
+  char spmsg[WF_MSG] = ""; /* snapshot plots at given times (snapshot_plots.c) */
+  if (t_stage == 0 && wf_snapplots_step(sim, sc, w->out, i, -1.0, 0.0, spmsg, sizeof spmsg))
+    return fail(w, MPMC_ERR_IO, "%s", spmsg);
   while (!reason) {
     if (s->dt <= 0 && (steps - s0) % 10 == 0)
       WF_TRY(w, mpmc_sim_stable_dt(sim, s->dt_factor, &dt), "stages.%d: time step", i);
     double h = dt;
     if (t_stage + h > T) h = T - t_stage; /* land on the stage's end */
-    const int e = mpmc_sim_step(sim, h);
+    const double t_plot = wf_snapplots_next(sc, i, t_stage);
+    if (t_stage + h > t_plot) h = t_plot - t_stage; /* and on the times of snapshot_plots */
+    char rmsg[WF_MSG] = "";
+    int e = wf_rigid_before_step(sim, sc, i, t_stage, rmsg, sizeof rmsg); /* rigid.c */
+    if (!e) e = mpmc_sim_step(sim, h);
+    if (!e) e = wf_rigid_after_step(sim, sc, rmsg, sizeof rmsg);
+    if (e && rmsg[0]) return fail(w, e, "stage '%s': %s: %s", s->name, rmsg, mpmc_context_last_error(w->ctx));
     if (e) {
       const double tt = t0 + t_stage;
-      return fail(w, e, "stage '%s' at t = %.6g s (step %ld): %s", s->name, tt, steps, mpmc_context_last_error(w->ctx));
+      return step_failed(w, e, s, tt, steps);
     }
     t_stage += h;
     ++steps;
+    if (sc->nsnapplot && wf_snapplots_step(sim, sc, w->out, i, t_stage - h, t_stage, spmsg, sizeof spmsg))
+      return fail(w, MPMC_ERR_IO, "%s", spmsg);
     const int at_end = t_stage >= T * (1 - 1e-9); /* not a sliver of a step for round-off */
     if (s->end_kind == WF_END_QUASI_STATIC) {
       /* quasi-static when the kinetic energy has fallen to ke_ratio of its stage maximum */
@@ -455,6 +500,7 @@ static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_m
   *nsteps = steps;
   rec->wall_seconds += wf_now() - w0;
   rec->reason = reason;
+  wf_metrics_stage_end(sim, &w->sc, i); /* metrics kept from the end of this stage */
   if (snapshot(w)) return -1;
   if (!strcmp(reason, "max_time"))
     say(w, "warning: stage %s reached max_time %g s before E_k/E_k,max fell below %g (last %.3g)", s->name,
@@ -518,7 +564,8 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
   double m[WF_METRIC_COUNT] = {0};
   if (w->sim && np > 0 && wf_metrics_compute(w->sim, &w->sc, m) == 0)
     for (int k = 0; k < WF_METRIC_COUNT; ++k)
-      if (w->sc.metrics.enabled[k]) fprintf(f, ",\n  \"%s\": %.9g", wf_metric_names[k], jnum(m[k]));
+      /* all 17 digits: the Fortran example is compared with the front end to 1e-9 relative */
+      if (w->sc.metrics.enabled[k]) fprintf(f, ",\n  \"%s\": %.17g", wf_metric_names[k], jnum(m[k]));
   fputs("\n}\n", f);
   fclose(f);
 }
@@ -534,6 +581,7 @@ static int open_outputs(wf_run *w, int append) {
       if (w->sc.metrics.enabled[k]) fprintf(w->series, ",%s", wf_metric_names[k]);
     fputc('\n', w->series);
   }
+  w->resumed = append;
   out_path(w, append ? "snapshots_resumed.h5" : "snapshots.h5", path, sizeof path);
   out_path(w, append ? "snapshots_resumed.xdmf" : "snapshots.xdmf", xpath, sizeof xpath);
   WF_TRY(w, mpmc_output_create(w->sim, path, xpath, &w->snap), "snapshots %s", path);
@@ -544,6 +592,10 @@ static int run_all(wf_run *w, int first_stage, double t_stage, long steps, doubl
   wf_progress pr;
   wf_progress_init(&pr);
   if (first_stage == 0 && t_stage == 0 && snapshot(w)) return -1;
+#ifdef MPMC_WF_HAVE_CHECKPOINT
+  /* the last good state exists from the start: a failure in the first stage keeps it */
+  if (first_stage == 0 && t_stage == 0 && !setup_done && checkpoint(w, 0, 0, steps, 0, 0)) return -1;
+#endif
   for (int i = first_stage; i < w->sc.nstage; ++i) {
     if (!(i == first_stage && setup_done) && stage_setup(w, i)) return -1;
     if (i == first_stage && t_stage == 0 && series_row(w, i, steps, 0, 0, 1)) return -1;
@@ -563,6 +615,7 @@ static int finish(wf_run *w, int err) {
     if (err == 0 && w->sc.plots && w->sim) {
       char warn[WF_MSG] = "";
       if (wf_plots_write(w->sim, &w->sc, w->out, warn, sizeof warn)) say(w, "warning: plots: %s", warn);
+      if (wf_snapplots_plot(&w->sc, w->out, warn, sizeof warn)) say(w, "warning: snapshot plots: %s", warn);
     }
     if (err == 0) {
       char path[WF_PATH];
@@ -729,6 +782,8 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
       snprintf(w.rec[i].name, sizeof w.rec[i].name, "%s", w.sc.stages[i].name);
     }
     w.sim = sim;
+    w.ckpt_ok = 1; /* the checkpoint resumed from is the last good state until the next one */
+    mpmc_sim_get_time(w.sim, &w.ckpt_time);
     w.strength = strength;
     set_threads(&w);
     mpmc_sim_set_threads(w.sim, w.sc.threads);

@@ -174,7 +174,16 @@ static wf_node *parse_yaml(const unsigned char *text, size_t len, const char *or
                          ev.data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE;
         }
         break;
-      case YAML_SEQUENCE_START_EVENT: made = node_new(WF_SEQ, line, col, origin); break;
+      case YAML_SEQUENCE_START_EVENT:
+        /* a list in a key's place ("[a, b]: c", found by fuzzing): keys are plain scalars */
+        if (depth > 0 && st[depth - 1].node->kind == WF_MAP && !st[depth - 1].pending_key) {
+          snprintf(msg, msglen, "%s:%d:%d: key '(complex)': only plain scalar keys are supported",
+                   origin, line, col);
+          yaml_event_delete(&ev);
+          goto fail;
+        }
+        made = node_new(WF_SEQ, line, col, origin);
+        break;
       case YAML_MAPPING_START_EVENT:
         if (depth > 0 && st[depth - 1].node->kind == WF_MAP && !st[depth - 1].pending_key) {
           snprintf(msg, msglen, "%s:%d:%d: key '(complex)': only plain scalar keys are supported",
@@ -698,6 +707,8 @@ static int read_geometry(rd *r, const wf_node *root, wf_scene *sc) {
         if (!p || p->kind != WF_SEQ || p->n != 2 || parse_number(p->items[0], &xy[0]) ||
             parse_number(p->items[1], &xy[1]))
           return fail_at(r, p, item, "expected a point [x, y] (got %s)", shown(p));
+        if (!isfinite(xy[0]) || !isfinite(xy[1]))
+          return fail_at(r, p, item, "expected finite coordinates (got [%g, %g])", xy[0], xy[1]);
         b->xy[2 * k] = xy[0];
         b->xy[2 * k + 1] = xy[1];
       }
@@ -762,6 +773,132 @@ static int read_walls(rd *r, const wf_node *list, const char *path, const wf_sce
   return 0;
 }
 
+/* rigid_bodies: a list of {name, type: box|polygon, lo/hi | vertices, friction}; contact:
+ * {dhat, kappa} (rigid.c, docs/contact.md).  Read before the stages, which move them. */
+static int read_rigid(rd *r, const wf_node *root, wf_scene *sc) {
+  const wf_node *cn = map_get(root, "contact");
+  if (cn) {
+    static const char *const ck[] = {"dhat", "kappa", NULL};
+    if (check_map(r, cn, "contact", ck)) return -1;
+    if (get_num(r, cn, "contact", "dhat", 0, 0, NONNEG, &sc->contact_dhat) ||
+        get_num(r, cn, "contact", "kappa", 0, 0, NONNEG, &sc->contact_kappa))
+      return -1;
+  }
+  const wf_node *rs = map_get(root, "rigid_bodies");
+  if (!rs) return 0;
+  if (rs->kind != WF_SEQ || rs->n == 0)
+    return fail_at(r, rs, "rigid_bodies", "expected a list of bodies, e.g. - {name: footing, type: box, lo: [..], hi: [..]}");
+  sc->rigid = calloc((size_t)rs->n, sizeof *sc->rigid);
+  if (!sc->rigid) return fail_at(r, rs, "rigid_bodies", "out of memory");
+  sc->nrigid = rs->n;
+  static const char *const types[] = {"box", "polygon", NULL};
+  static const char *const keys[] = {"name", "type", "lo", "hi", "vertices", "friction", NULL};
+  for (int i = 0; i < rs->n; ++i) {
+    wf_rigid *b = &sc->rigid[i];
+    const wf_node *g = rs->items[i];
+    char path[64], full[512], def[WF_NAME];
+    snprintf(path, sizeof path, "rigid_bodies.%d", i);
+    snprintf(def, sizeof def, "body%d", i + 1);
+    b->id = i; /* bodies are added in scene order to a fresh simulation (and a checkpoint) */
+    if (check_map(r, g, path, keys)) return -1;
+    if (get_str(r, g, path, "name", 0, def, b->name, sizeof b->name)) return -1;
+    for (int j = 0; j < i; ++j)
+      if (!strcmp(sc->rigid[j].name, b->name)) {
+        join(full, sizeof full, path, "name");
+        return fail_at(r, map_get(g, "name"), full, "a rigid body named '%s' exists already", b->name);
+      }
+    if (get_enum(r, g, path, "type", 1, 0, types, &b->type)) return -1;
+    if (get_num(r, g, path, "friction", 0, 0, NONNEG, &b->friction)) return -1;
+    if (b->type == WF_GEOM_BOX) {
+      if (get_vec(r, g, path, "lo", 1, sc->dim, ANY, b->lo) || get_vec(r, g, path, "hi", 1, sc->dim, ANY, b->hi))
+        return -1;
+      for (int a = 0; a < sc->dim; ++a)
+        if (b->hi[a] <= b->lo[a]) {
+          join(full, sizeof full, path, "hi");
+          return fail_at(r, map_get(g, "hi"), full, "component %d must be > lo (%g) (got %g)", a, b->lo[a],
+                         b->hi[a]);
+        }
+      continue;
+    }
+    join(full, sizeof full, path, "vertices");
+    const wf_node *v = map_get(g, "vertices");
+    if (sc->dim != 2) return fail_at(r, map_get(g, "type"), full, "rigid polygons are 2D only (dim = %d)", sc->dim);
+    if (!v) return fail_at(r, g, full, "required key is missing");
+    if (v->kind != WF_SEQ || v->n < 3) return fail_at(r, v, full, "expected a list of at least 3 [x, y] points");
+    b->nvert = v->n;
+    b->xy = malloc(sizeof(double) * 2 * (size_t)v->n);
+    if (!b->xy) return fail_at(r, v, full, "out of memory");
+    for (int k = 0; k < v->n; ++k) {
+      char item[560];
+      snprintf(item, sizeof item, "%s.%d", full, k);
+      const wf_node *p = v->items[k];
+      if (!p || p->kind != WF_SEQ || p->n != 2 || parse_number(p->items[0], &b->xy[2 * k]) ||
+          parse_number(p->items[1], &b->xy[2 * k + 1]))
+        return fail_at(r, p, item, "expected a point [x, y] (got %s)", shown(p));
+    }
+  }
+  return 0;
+}
+
+/* stages.N.rigid_bodies: {NAME: {velocity: [..], ramp: T}} */
+static int read_motion(rd *r, const wf_node *n, const char *path, const wf_scene *sc, wf_stage *s) {
+  char full[512];
+  join(full, sizeof full, path, "rigid_bodies");
+  if (n->kind != WF_MAP || n->n == 0)
+    return fail_at(r, n, full, "expected a map of body names, e.g. footing: {velocity: [0, -0.01], ramp: 0.2}");
+  s->motion = calloc((size_t)n->n, sizeof *s->motion);
+  if (!s->motion) return fail_at(r, n, full, "out of memory");
+  s->nmotion = n->n;
+  static const char *const keys[] = {"velocity", "ramp", NULL};
+  for (int k = 0; k < n->n; ++k) {
+    char p[600];
+    snprintf(p, sizeof p, "%s.%s", full, n->keys[k]);
+    wf_rigid_motion *m = &s->motion[k];
+    m->body = -1;
+    for (int b = 0; b < sc->nrigid; ++b)
+      if (!strcmp(sc->rigid[b].name, n->keys[k])) m->body = b;
+    if (m->body < 0) {
+      char list[256] = "";
+      for (int b = 0; b < sc->nrigid; ++b) {
+        const size_t l = strlen(list);
+        snprintf(list + l, sizeof list - l, "%s%s", b ? ", " : "", sc->rigid[b].name);
+      }
+      return fail_at(r, n->items[k], p, "no rigid body '%s' (rigid_bodies: %s)", n->keys[k],
+                     sc->nrigid ? list : "none");
+    }
+    if (check_map(r, n->items[k], p, keys)) return -1;
+    if (get_vec(r, n->items[k], p, "velocity", 1, sc->dim, ANY, m->velocity)) return -1;
+    if (get_num(r, n->items[k], p, "ramp", 0, 0, NONNEG, &m->ramp)) return -1;
+  }
+  return 0;
+}
+
+/* metrics.bearing_capacity_ratio: {body, width, loaded_width, su, axis, from} (rigid.c) */
+static int read_bearing(rd *r, const wf_node *v, const char *p, wf_scene *sc) {
+  static const char *const keys[] = {"body", "width", "loaded_width", "su", "axis", "from", NULL};
+  wf_metrics *m = &sc->metrics;
+  char name[WF_NAME], full[512];
+  if (check_map(r, v, p, keys)) return -1;
+  if (get_str(r, v, p, "body", sc->nrigid != 1, sc->nrigid ? sc->rigid[0].name : "", name, sizeof name)) return -1;
+  m->bearing_body = -1;
+  for (int b = 0; b < sc->nrigid; ++b)
+    if (!strcmp(sc->rigid[b].name, name)) m->bearing_body = b;
+  join(full, sizeof full, p, "body");
+  if (m->bearing_body < 0)
+    return fail_at(r, map_get(v, "body") ? map_get(v, "body") : v, full, "no rigid body '%s'", name);
+  const range from = {0, 1, 0, 1};
+  if (get_num(r, v, p, "width", 1, 0, POS, &m->bearing_B) ||
+      get_num(r, v, p, "loaded_width", 0, m->bearing_B, POS, &m->bearing_width) ||
+      get_num(r, v, p, "su", 1, 0, POS, &m->bearing_su) ||
+      get_enum(r, v, p, "axis", 0, sc->dim - 1, axis_words, &m->bearing_axis) ||
+      get_num(r, v, p, "from", 0, 0.5, from, &m->bearing_from))
+    return -1;
+  join(full, sizeof full, p, "axis");
+  if (m->bearing_axis >= sc->dim) return fail_at(r, map_get(v, "axis"), full, "no axis z in 2D");
+  m->enabled[WF_METRIC_SETTLEMENT_B] = m->enabled[WF_METRIC_Q_SU] = m->enabled[WF_METRIC_BEARING] = 1;
+  return 0;
+}
+
 static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   const wf_node *ss = map_get(root, "stages");
   if (!ss) return fail_at(r, root, "stages", "required key is missing");
@@ -771,7 +908,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
   static const char *const keys[] = {"name", "gravity", "damping", "walls", "remove_walls", "tractions",
                                      "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
-                                     "snapshots", "series_points", NULL};
+                                     "snapshots", "series_points", "rigid_bodies", "force_dt", NULL};
   static const char *const end_keys[] = {"time", "kinetic_energy_ratio", "max_time", "min_time", NULL};
   static const char *const tr_keys[] = {"set", "lo", "hi", "traction", NULL};
   for (int i = 0; i < ss->n; ++i) {
@@ -792,6 +929,8 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     /* 0: unchanged from the previous stage */
     if (get_num(r, n, p, "strength_reduction", 0, 0.0, srf, &s->strength_reduction)) return -1;
     if (get_bool(r, n, p, "reset_velocity", 0, &s->reset_velocity)) return -1;
+    /* a time step above the stability limit is refused unless forced (mpmc_sim_set_force_dt) */
+    if (get_bool(r, n, p, "force_dt", 0, &s->force_dt)) return -1;
     const range fac = {0, 1, 1, 0};
     if (get_num(r, n, p, "dt_factor", 0, 0.3, fac, &s->dt_factor)) return -1;
     if (get_num(r, n, p, "dt", 0, 0, NONNEG, &s->dt)) return -1;
@@ -800,6 +939,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     char wp[128];
     snprintf(wp, sizeof wp, "%s.walls", p);
     if (map_get(n, "walls") && read_walls(r, map_get(n, "walls"), wp, sc, s)) return -1;
+    if (map_get(n, "rigid_bodies") && read_motion(r, map_get(n, "rigid_bodies"), p, sc, s)) return -1;
     const wf_node *rm = map_get(n, "remove_walls");
     if (rm) {
       join(full, sizeof full, p, "remove_walls");
@@ -857,7 +997,106 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
       if (get_num(r, e, full, "kinetic_energy_ratio", 1, 0, tol, &s->ke_ratio)) return -1;
       if (get_num(r, e, full, "max_time", 1, 0, POS, &s->max_time)) return -1;
       if (get_num(r, e, full, "min_time", 0, 0, NONNEG, &s->min_time)) return -1;
+      char mt[560];
+      join(mt, sizeof mt, full, "min_time");
+      if (s->min_time > s->max_time)
+        return fail_at(r, map_get(e, "min_time"), mt, "must not exceed max_time = %g (got %g)", s->max_time,
+                       s->min_time);
       s->end_time = s->max_time;
+    }
+  }
+  return 0;
+}
+
+/* A stage named in `map`.`key` (by name or index); absent: def. */
+static int find_stage(rd *r, const wf_node *map, const char *path, const char *key, const wf_scene *sc, int def,
+                      int *out) {
+  char name[WF_NAME], full[512];
+  join(full, sizeof full, path, key);
+  if (get_str(r, map, path, key, 0, "", name, sizeof name)) return -1;
+  if (!name[0]) return *out = def, 0;
+  for (int i = 0; i < sc->nstage; ++i)
+    if (!strcmp(sc->stages[i].name, name)) return *out = i, 0;
+  char *end;
+  const long k = strtol(name, &end, 10);
+  if (!*end && k >= 0 && k < sc->nstage) return *out = (int)k, 0;
+  char list[256] = "";
+  for (int i = 0; i < sc->nstage; ++i) {
+    const size_t l = strlen(list);
+    snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", sc->stages[i].name);
+  }
+  return fail_at(r, map_get(map, key), full, "no stage '%s' (stages: %s)", name, list);
+}
+
+/* metrics.hydrostatic_pressure_error: {surface: level of the free surface, stage: the stage
+ * at whose end it is evaluated (default: live, the run's end)}; g is that stage's gravity. */
+static int read_hydrostatic(rd *r, const wf_node *v, const char *p, wf_scene *sc) {
+  static const char *const keys[] = {"surface", "stage", NULL};
+  wf_metrics *m = &sc->metrics;
+  if (check_map(r, v, p, keys)) return -1;
+  if (get_num(r, v, p, "surface", 1, 0, ANY, &m->surface)) return -1;
+  if (find_stage(r, v, p, "stage", sc, -1, &m->hydro_stage)) return -1;
+  const int last = m->hydro_stage >= 0 ? m->hydro_stage : sc->nstage - 1;
+  const double *g = NULL;
+  for (int i = 0; i <= last; ++i)
+    if (sc->stages[i].has_gravity) g = sc->stages[i].gravity;
+  double best = 0;
+  for (int a = 0; g && a < sc->dim; ++a)
+    if (fabs(g[a]) > best) {
+      best = fabs(g[a]);
+      m->hydro_axis = a;
+    }
+  if (best == 0) return fail_at(r, v, p, "needs gravity (no stage up to '%s' sets it)", sc->stages[last].name);
+  m->hydro_g = best;
+  m->enabled[WF_METRIC_HYDRO] = 1;
+  return 0;
+}
+
+/* snapshot_plots: [{stage, times: [..], color, range: [lo, hi]}, ...] (snapshot_plots.c) */
+static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
+  const wf_node *ls = map_get(root, "snapshot_plots");
+  if (!ls) return 0;
+  if (ls->kind != WF_SEQ || ls->n == 0)
+    return fail_at(r, ls, "snapshot_plots", "expected a list, e.g. - {stage: runout, times: [1, 2], color: eps_p}");
+  sc->snapplots = calloc((size_t)ls->n, sizeof *sc->snapplots);
+  if (!sc->snapplots) return fail_at(r, ls, "snapshot_plots", "out of memory");
+  sc->nsnapplot = ls->n;
+  static const char *const keys[] = {"stage", "times", "color", "range", NULL};
+  int plastic = 0;
+  for (int i = 0; i < sc->nmat; ++i) plastic |= sc->mats[i].model == WF_MODEL_HENCKY_J2;
+  for (int k = 0; k < ls->n; ++k) {
+    wf_snapplot *sp = &sc->snapplots[k];
+    const wf_node *n = ls->items[k];
+    char p[64], full[512];
+    snprintf(p, sizeof p, "snapshot_plots.%d", k);
+    if (check_map(r, n, p, keys)) return -1;
+    if (find_stage(r, n, p, "stage", sc, 0, &sp->stage)) return -1;
+    if (get_enum(r, n, p, "color", 0, WF_COLOR_MEAN_STRESS, wf_color_names, &sp->color)) return -1;
+    join(full, sizeof full, p, "color");
+    if (sp->color == WF_COLOR_EPS_P && !plastic)
+      return fail_at(r, map_get(n, "color"), full, "eps_p needs a plastic (hencky_j2) material");
+    sp->has_range = map_get(n, "range") != NULL;
+    if (get_vec(r, n, p, "range", 0, 2, ANY, sp->range)) return -1;
+    join(full, sizeof full, p, "range");
+    if (sp->has_range && !(sp->range[1] > sp->range[0]))
+      return fail_at(r, map_get(n, "range"), full, "expected [lo, hi] with hi > lo (got [%g, %g])", sp->range[0],
+                     sp->range[1]);
+    const wf_node *t = map_get(n, "times");
+    join(full, sizeof full, p, "times");
+    if (!t) return fail_at(r, n, full, "required key is missing");
+    if (t->kind != WF_SEQ || t->n == 0 || t->n > 64) return fail_at(r, t, full, "expected a list of 1 to 64 times [s]");
+    sp->times = calloc((size_t)t->n, sizeof *sp->times);
+    if (!sp->times) return fail_at(r, t, full, "out of memory");
+    sp->ntimes = t->n;
+    const double T = sc->stages[sp->stage].end_time;
+    for (int j = 0; j < t->n; ++j) {
+      char item[560];
+      snprintf(item, sizeof item, "%s.%d", full, j);
+      if (parse_number(t->items[j], &sp->times[j]))
+        return fail_at(r, t->items[j], item, "expected a number (got '%s')", shown(t->items[j]));
+      if (!(sp->times[j] >= 0 && sp->times[j] <= T))
+        return fail_at(r, t->items[j], item, "must be in [0, %g], the duration of stage %s (got %g)", T,
+                       sc->stages[sp->stage].name, sp->times[j]);
     }
   }
   return 0;
@@ -867,7 +1106,8 @@ static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
   const wf_node *m = map_get(root, "metrics");
   if (!m) return 0;
   static const char *const keys[] = {"runout_distance", "tip_displacement_y", "tip_displacement_x",
-                                     "center_of_mass_x", NULL};
+                                     "center_of_mass_x", "bearing_capacity_ratio", "surge_front_x",
+                                     "hydrostatic_pressure_error", NULL};
   if (check_map(r, m, "metrics", keys)) return -1;
   static const char *const rk[] = {"toe", "axis", NULL};
   static const char *const tk[] = {"point", NULL};
@@ -890,6 +1130,13 @@ static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
       sc->metrics.enabled[m->keys[i][17] == 'y' ? WF_METRIC_TIP_Y : WF_METRIC_TIP_X] = 1;
       if (check_map(r, v, p, tk)) return -1;
       if (get_vec(r, v, p, "point", 1, sc->dim, ANY, sc->metrics.point)) return -1;
+    } else if (!strcmp(m->keys[i], "bearing_capacity_ratio")) {
+      if (read_bearing(r, v, p, sc)) return -1;
+    } else if (!strcmp(m->keys[i], "surge_front_x")) {
+      sc->metrics.enabled[WF_METRIC_FRONT_X] = 1;
+      if (!empty && check_map(r, v, p, none)) return -1;
+    } else if (!strcmp(m->keys[i], "hydrostatic_pressure_error")) {
+      if (read_hydrostatic(r, v, p, sc)) return -1;
     } else {
       sc->metrics.enabled[WF_METRIC_COM_X] = 1;
       if (!empty && check_map(r, v, p, none)) return -1;
@@ -901,7 +1148,8 @@ static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
 static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   static const char *const keys[] = {"scene", "description", "dim", "geometry", "grid", "basis", "fbar",
                                      "flip", "solver", "threads", "materials", "stages", "metrics",
-                                     "plots", "checkpoint_interval", "progress_interval", NULL};
+                                     "plots", "checkpoint_interval", "progress_interval", "rigid_bodies",
+                                     "contact", "snapshot_plots", NULL};
   if (check_map(r, root, "", keys)) return -1;
   char def[WF_NAME];
   const char *base = strrchr(sc->path, '/');
@@ -947,8 +1195,8 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   if (get_bool(r, root, "", "plots", 1, &sc->plots)) return -1;
   if (get_num(r, root, "", "checkpoint_interval", 0, 300, POS, &sc->checkpoint_interval)) return -1;
   if (get_num(r, root, "", "progress_interval", 0, 5, POS, &sc->progress_interval)) return -1;
-  if (read_materials(r, root, sc) || read_geometry(r, root, sc) || read_stages(r, root, sc) ||
-      read_metrics(r, root, sc))
+  if (read_materials(r, root, sc) || read_geometry(r, root, sc) || read_rigid(r, root, sc) || read_stages(r, root, sc) ||
+      read_metrics(r, root, sc) || read_snapplots(r, root, sc))
     return -1;
   return 0;
 }
@@ -1025,12 +1273,17 @@ int wf_scene_load(const char *path, int noverride, const char *const *overrides,
 
 void wf_scene_free(wf_scene *sc) {
   if (!sc) return;
+  wf_rigid_free(sc);
   for (int i = 0; i < sc->nbody && sc->bodies; ++i) free(sc->bodies[i].xy);
   for (int i = 0; i < sc->nstage && sc->stages; ++i) {
     free(sc->stages[i].walls);
     free(sc->stages[i].remove);
     free(sc->stages[i].tractions);
   }
+  for (int i = 0; i < sc->nsnapplot && sc->snapplots; ++i) free(sc->snapplots[i].times);
+  free(sc->snapplots);
+  sc->snapplots = NULL;
+  sc->nsnapplot = 0;
   free(sc->bodies);
   free(sc->stages);
   free(sc->mats);

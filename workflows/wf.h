@@ -59,6 +59,24 @@ typedef struct {
   double velocity[3];       /* initial velocity                                     */
 } wf_body;
 
+/* Rigid bodies (scene key rigid_bodies; rigid.c): a box (2D/3D) or polygon (2D) pushed
+ * through the barrier contact of contact_barrier.c, moved per stage (wf_rigid_motion). */
+typedef struct {
+  char name[WF_NAME];
+  int type;                 /* WF_GEOM_BOX or WF_GEOM_POLYGON                       */
+  double lo[3], hi[3];      /* box                                                  */
+  int nvert;                /* polygon                                              */
+  double *xy;
+  double friction;          /* Coulomb coefficient mu (large: rough)                */
+  int id;                   /* in the simulation                                    */
+} wf_rigid;
+
+typedef struct {
+  int body;                 /* index into scene rigid bodies                        */
+  double velocity[3];       /* from this stage on                                   */
+  double ramp;              /* [s] linear ramp from the previous stage's velocity   */
+} wf_rigid_motion;
+
 typedef struct {
   char name[WF_NAME];       /* "" when unnamed                                      */
   int kind;                 /* mpmc_wall_kind                                       */
@@ -89,15 +107,21 @@ typedef struct {
   double strength_reduction; /* strengths are the material's / this factor from this
                               * stage on (absolute, not cumulative); 0 = unchanged   */
   int reset_velocity;
+  int force_dt;               /* accept a dt above the stability limit            */
   int end_kind;
   double end_time;           /* stage duration [s] (WF_END_TIME)                    */
   double ke_ratio, max_time, min_time; /* quasi-static end                          */
   double dt_factor, dt;      /* dt > 0: fixed step                                  */
   int snapshots;             /* HDF5 snapshots during the stage (plus its end)      */
   int series_points;         /* rows of series.csv for the stage                    */
+  int nmotion;               /* rigid-body velocities set by the stage (rigid.c)    */
+  wf_rigid_motion *motion;
 } wf_stage;
 
-typedef enum { WF_METRIC_RUNOUT, WF_METRIC_TIP_Y, WF_METRIC_TIP_X, WF_METRIC_COM_X, WF_METRIC_COUNT } wf_metric_kind;
+typedef enum { WF_METRIC_RUNOUT, WF_METRIC_TIP_Y, WF_METRIC_TIP_X, WF_METRIC_COM_X,
+  WF_METRIC_SETTLEMENT_B, WF_METRIC_Q_SU, WF_METRIC_BEARING, /* bearing_capacity_ratio (rigid.c) */
+  WF_METRIC_FRONT_X, WF_METRIC_HYDRO, /* surge_front_x, hydrostatic_pressure_error (report.c) */
+  WF_METRIC_COUNT } wf_metric_kind;
 typedef struct {
   int enabled[WF_METRIC_COUNT];
   int has_toe;
@@ -105,7 +129,30 @@ typedef struct {
   int runout_axis;
   double point[3];           /* tip displacement: the point whose motion is tracked */
   int tip_index;             /* the nearest material point (set at run time)        */
+  /* bearing_capacity_ratio (rigid.c, docs/contact.md): body, footing width B for delta/B,
+   * the width the modelled reaction acts on (B/2 in a half model), su, the load axis, and
+   * the window: mean q/su over settlements from `from` x the final settlement on */
+  int bearing_body, bearing_axis;
+  double bearing_B, bearing_width, bearing_su, bearing_from;
+  struct wf_bearing *bearing; /* per-step record (run time)                          */
+  /* hydrostatic_pressure_error (report.c): RMS of p - rho g (surface - x_v) over the RMS of
+   * rho g (surface - x_v), x_v along gravity; live, or kept from the end of hydro_stage */
+  double surface, hydro_g;
+  int hydro_axis, hydro_stage, hydro_frozen;
+  double hydro_value;
 } wf_metrics;
+
+/* ---- snapshot plots at given times (snapshot_plots.c) ------------------------------ */
+typedef enum { WF_COLOR_PRESSURE, WF_COLOR_MEAN_STRESS, WF_COLOR_EPS_P, WF_COLOR_DISPLACEMENT, WF_COLOR_SPEED,
+               WF_COLOR_COUNT } wf_color;
+typedef struct {
+  int stage;                 /* times are measured from the start of this stage          */
+  int color;                 /* wf_color                                                  */
+  int ntimes;
+  double *times;             /* [s] after the stage's start                              */
+  int has_range;
+  double range[2];           /* colour range (default: common min/max of the snapshots)  */
+} wf_snapplot;
 
 typedef struct {
   char path[WF_PATH];        /* the scene file as given                             */
@@ -121,7 +168,12 @@ typedef struct {
   wf_body *bodies;
   int nstage;
   wf_stage *stages;
+  int nrigid;                /* rigid bodies (rigid.c)                               */
+  wf_rigid *rigid;
+  double contact_dhat, contact_kappa; /* barrier parameters, 0: defaults           */
   wf_metrics metrics;
+  int nsnapplot;             /* snapshot_plots: PNGs of the state at given times        */
+  wf_snapplot *snapplots;
   int plots;                 /* write PNG plots                                     */
   double checkpoint_interval;/* wall seconds between checkpoints inside a stage     */
   double progress_interval;  /* wall seconds between plain progress lines           */
@@ -153,10 +205,36 @@ void wf_progress_update(wf_progress *p, const wf_scene *sc, int stage, double t_
                         double t_end, long steps, double steps_per_s, double interval, int force);
 void wf_progress_done(wf_progress *p);
 
+/* ---- rigid bodies (rigid.c) ------------------------------------------------------ */
+/* Add the scene's rigid bodies and barrier parameters to the simulation. */
+int wf_rigid_build(mpmc_sim sim, wf_scene *sc, char *msg, size_t len);
+/* Before each step of stage i, t_stage into it: set the bodies' (ramped) velocities. */
+int wf_rigid_before_step(mpmc_sim sim, const wf_scene *sc, int stage, double t_stage, char *msg,
+                         size_t len);
+/* After each step: record the footing's settlement and load (bearing_capacity_ratio). */
+int wf_rigid_after_step(mpmc_sim sim, const wf_scene *sc, char *msg, size_t len);
+/* The bearing metrics of the record: delta/B and q/su (mean since the last call with
+ * mark = 1), and the ratio over the window; NAN without a record. */
+void wf_bearing_values(const wf_scene *sc, int mark, double *delta_b, double *q_su, double *ratio);
+void wf_rigid_free(wf_scene *sc);
+
 /* ---- plots (plot.c) -------------------------------------------------------------- */
 /* Final state (coloured by mean stress and equivalent plastic strain) and time series.
  * Returns 0, or 1 when gnuplot is missing or failed (a warning, not an error). */
 int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *warn, size_t len);
+
+/* Keep metrics defined at the end of a stage (hydrostatic_pressure_error); report.c. */
+int wf_metrics_stage_end(mpmc_sim sim, wf_scene *sc, int stage);
+
+/* ---- snapshot plots (snapshot_plots.c) ------------------------------------------- */
+extern const char *const wf_color_names[WF_COLOR_COUNT + 1]; /* NULL-terminated (get_enum) */
+/* The next requested time of `stage` after t_stage (INFINITY: none): the run lands on it. */
+double wf_snapplots_next(const wf_scene *sc, int stage, double t_stage);
+/* Keep the state (snap_*.csv in outdir) for the requested times in (t_prev, t_stage]. */
+int wf_snapplots_step(mpmc_sim sim, const wf_scene *sc, const char *outdir, int stage, double t_prev,
+                      double t_stage, char *msg, size_t len);
+/* Draw the PNGs of the kept snapshots; 0, or 1 with a warning (like wf_plots_write). */
+int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t len);
 
 /* ---- gmsh (gmsh_plugin.c) -------------------------------------------------------- */
 int wf_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,

@@ -1,0 +1,241 @@
+/* Snapshot plots at given times (scene key `snapshot_plots`): during the run the state at
+ * each requested time of a stage is kept as snap_<stage>_t<time>_<colour>.csv in the output
+ * directory (the step before the time is shortened so that the run lands on it); at the end
+ * gnuplot draws one PNG per time and one panel figure per entry, all with the same colour
+ * range and the same axes, so that the pictures compare.  2D: the plane; 3D: a side view
+ * onto the plane of the horizontal axis (the run-out axis, else x) and the vertical (the
+ * gravity direction), near points drawn last, as in the final-state plots (plot.c). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include "wf.h"
+
+const char *const wf_color_names[WF_COLOR_COUNT + 1] = {"pressure", "mean_stress", "eps_p", "displacement", "speed", NULL};
+static const char *const color_labels[WF_COLOR_COUNT] = {
+    "pressure -tr(sigma)/3 [kPa]", "mean stress tr(sigma)/3 [kPa]", "equivalent plastic strain eps_p",
+    "displacement |u| [m]", "speed |v| [m/s]"};
+
+/* Time-window tolerance: a requested time counts as reached within round-off of it. */
+static double tol_of(double t) { return 1e-9 * fmax(1.0, fabs(t)); }
+
+/** @brief The next requested plot time of `stage` after t_stage (INFINITY: none). */
+double wf_snapplots_next(const wf_scene *sc, int stage, double t_stage) {
+  double next = INFINITY;
+  for (int k = 0; k < sc->nsnapplot; ++k) {
+    const wf_snapplot *p = &sc->snapplots[k];
+    if (p->stage != stage) continue;
+    for (int j = 0; j < p->ntimes; ++j)
+      if (p->times[j] > t_stage + tol_of(p->times[j]) && p->times[j] < next) next = p->times[j];
+  }
+  return next;
+}
+
+static void csv_name(const wf_scene *sc, const wf_snapplot *p, int j, char *buf, size_t len) {
+  snprintf(buf, len, "snap_%s_t%g_%s.csv", sc->stages[p->stage].name, p->times[j], wf_color_names[p->color]);
+}
+
+/* The vertical axis: the largest gravity component of the stages that set gravity. */
+static int vertical_of(const wf_scene *sc) {
+  if (sc->dim == 2) return 1;
+  int v = 2;
+  for (int i = 0; i < sc->nstage; ++i) {
+    if (!sc->stages[i].has_gravity) continue;
+    double best = 0;
+    for (int a = 0; a < sc->dim; ++a)
+      if (fabs(sc->stages[i].gravity[a]) > best) {
+        best = fabs(sc->stages[i].gravity[a]);
+        v = a;
+      }
+  }
+  return v;
+}
+
+static void view_axes(const wf_scene *sc, int *hx, int *vy) {
+  *vy = vertical_of(sc);
+  *hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
+  if (*hx == *vy) *hx = *vy == 0 ? 1 : 0;
+}
+
+typedef struct {
+  double depth;
+  int q;
+} far_first;
+
+static int by_far(const void *a, const void *b) {
+  const double da = ((const far_first *)a)->depth, db = ((const far_first *)b)->depth;
+  return da < db ? 1 : da > db ? -1 : 0;
+}
+
+static int write_csv(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, const char *path, double t) {
+  int np, e;
+  double *x, *x0, *v, *sig, *eps = NULL;
+  mpmc_sim_get_num_particles(sim, &np);
+  if ((e = mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL)) ||
+      (e = mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
+      (e = mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL)) ||
+      (e = mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL)))
+    return e;
+  if (p->color == WF_COLOR_EPS_P && (e = mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL))) return e;
+  const int d = sc->dim;
+  int hx, vy;
+  view_axes(sc, &hx, &vy);
+  const int dz = 3 - hx - vy;
+  far_first *order = malloc(sizeof *order * (size_t)(np + 1));
+  FILE *f = order ? fopen(path, "w") : NULL;
+  if (!f) {
+    free(order);
+    return MPMC_ERR_IO;
+  }
+  for (int q = 0; q < np; ++q) {
+    order[q].q = q;
+    order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
+  }
+  if (d == 3) qsort(order, (size_t)np, sizeof *order, by_far);
+  fprintf(f, "# %s at t = %.9g s of stage %s\n%c,%c,%s\n", wf_color_names[p->color], t, sc->stages[p->stage].name,
+          "xyz"[hx], "xyz"[vy], wf_color_names[p->color]);
+  for (int k = 0; k < np; ++k) {
+    const size_t q = (size_t)order[k].q;
+    double val = 0.0, a2 = 0.0;
+    switch (p->color) {
+      case WF_COLOR_PRESSURE: val = -(sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3000.0; break;
+      case WF_COLOR_MEAN_STRESS: val = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3000.0; break;
+      case WF_COLOR_EPS_P: val = eps[q]; break;
+      case WF_COLOR_DISPLACEMENT:
+        for (int a = 0; a < d; ++a) a2 += pow(x[q * d + a] - x0[q * d + a], 2);
+        val = sqrt(a2);
+        break;
+      default:
+        for (int a = 0; a < d; ++a) a2 += v[q * d + a] * v[q * d + a];
+        val = sqrt(a2);
+        break;
+    }
+    fprintf(f, "%.7g,%.7g,%.7g\n", x[q * d + hx], x[q * d + vy], val);
+  }
+  free(order);
+  return fclose(f) ? MPMC_ERR_IO : 0;
+}
+
+/**
+ * @brief Keep the state for every requested time of `stage` in (t_prev, t_stage].
+ * @return 0, or an error code with a message in msg
+ */
+int wf_snapplots_step(mpmc_sim sim, const wf_scene *sc, const char *outdir, int stage, double t_prev,
+                      double t_stage, char *msg, size_t len) {
+  for (int k = 0; k < sc->nsnapplot; ++k) {
+    const wf_snapplot *p = &sc->snapplots[k];
+    if (p->stage != stage) continue;
+    for (int j = 0; j < p->ntimes; ++j) {
+      const double tj = p->times[j], tol = tol_of(tj);
+      if (!(t_prev < tj - tol && t_stage >= tj - tol)) continue;
+      char name[WF_NAME * 2 + 64], path[WF_PATH + WF_NAME * 2 + 64];
+      csv_name(sc, p, j, name, sizeof name);
+      snprintf(path, sizeof path, "%s/%s", outdir, name);
+      const int e = write_csv(sim, sc, p, path, t_stage);
+      if (e) {
+        snprintf(msg, len, "snapshot_plots.%d: cannot write %s", k, path);
+        return e;
+      }
+    }
+  }
+  return 0;
+}
+
+static int exists(const char *path) {
+  struct stat s;
+  return stat(path, &s) == 0;
+}
+
+/**
+ * @brief Draw the PNGs of every snapshot kept in outdir: snapshot_<stage>_t<time>_<colour>.png
+ *        and, per entry, snapshots_<stage>_<colour>.png with all its times as panels.
+ * @return 0, or 1 with a warning in warn (gnuplot missing or failed, times never reached)
+ */
+int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t len) {
+  if (sc->nsnapplot == 0) return 0;
+  if (strpbrk(outdir, "\"'\\`$")) {
+    snprintf(warn, len, "output path has quote characters; snapshot plots skipped");
+    return 1;
+  }
+  if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    snprintf(warn, len, "gnuplot not found (Debian package gnuplot-nox): no snapshot PNGs, the data is in snap_*.csv");
+    return 1;
+  }
+  char cmd[WF_PATH + 64];
+  snprintf(cmd, sizeof cmd, "gnuplot >'%s/snapshot_plots.log' 2>&1", outdir);
+  FILE *g = popen(cmd, "w");
+  if (!g) {
+    snprintf(warn, len, "cannot start gnuplot");
+    return 1;
+  }
+  int missing = 0;
+  fprintf(g, "cd \"%s\"\nset datafile separator ','\nset grid\n", outdir);
+  fprintf(g, "set palette defined (0 '#313695', 1 '#4575b4', 2 '#74add1', 3 '#abd9e9', 4 '#fee090', "
+             "5 '#fdae61', 6 '#f46d43', 7 '#d73027', 8 '#a50026')\n");
+  int hx, vy;
+  view_axes(sc, &hx, &vy);
+  for (int k = 0; k < sc->nsnapplot; ++k) {
+    const wf_snapplot *p = &sc->snapplots[k];
+    const char *stage = sc->stages[p->stage].name, *col = wf_color_names[p->color];
+    char files[64][WF_NAME * 2 + 64];
+    double when[64];
+    int n = 0;
+    for (int j = 0; j < p->ntimes && n < 64; ++j) {
+      char path[WF_PATH + WF_NAME * 2 + 64];
+      csv_name(sc, p, j, files[n], sizeof files[n]);
+      snprintf(path, sizeof path, "%s/%s", outdir, files[n]);
+      if (!exists(path)) {
+        ++missing;
+        continue;
+      }
+      when[n++] = p->times[j];
+    }
+    if (n == 0) continue;
+    /* one colour range and one frame for all the times of this entry */
+    fprintf(g, "vlo = 1e300; vhi = -1e300; xlo = 1e300; xhi = -1e300; ylo = 1e300; yhi = -1e300\n");
+    for (int j = 0; j < n; ++j)
+      fprintf(g, "stats '%s' skip 2 using 1:2 nooutput\nxlo = (STATS_min_x < xlo) ? STATS_min_x : xlo; "
+                 "xhi = (STATS_max_x > xhi) ? STATS_max_x : xhi; ylo = (STATS_min_y < ylo) ? STATS_min_y : ylo; "
+                 "yhi = (STATS_max_y > yhi) ? STATS_max_y : yhi\n"
+                 "stats '%s' skip 2 using 3 nooutput\nvlo = (STATS_min < vlo) ? STATS_min : vlo; "
+                 "vhi = (STATS_max > vhi) ? STATS_max : vhi\n",
+              files[j], files[j]);
+    if (p->has_range)
+      fprintf(g, "vlo = %.9g; vhi = %.9g\n", p->range[0], p->range[1]);
+    fprintf(g, "if (vhi <= vlo) { vhi = vlo + 1 }\npad = 0.03 * ((xhi - xlo) > (yhi - ylo) ? (xhi - xlo) : (yhi - ylo))\n"
+               "set xrange [xlo - pad : xhi + pad]\nset yrange [ylo - pad : yhi + pad]\nset cbrange [vlo : vhi]\n");
+    fprintf(g, "set size ratio -1\nset xlabel '%c [m]'\nset ylabel '%c [m]'\nset cblabel '%s' noenhanced\n", "xyz"[hx],
+            "xyz"[vy], color_labels[p->color]);
+    for (int j = 0; j < n; ++j) {
+      fprintf(g, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1200,800 font ',12' } "
+                 "else { set terminal png size 1200,800 }\n");
+      fprintf(g, "set output 'snapshot_%s_t%g_%s.png'\n", stage, when[j], col);
+      fprintf(g, "set title '%s%s: %s at t = %g s of stage %s' noenhanced\n", sc->name, sc->dim == 3 ? " (side view)" : "",
+              col, when[j], stage);
+      fprintf(g, "plot '%s' skip 2 using 1:2:3 with points pt 7 ps 0.4 lc palette notitle\n", files[j]);
+    }
+    const int cols = n < 2 ? 1 : 2, rows = (n + cols - 1) / cols;
+    fprintf(g, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size %d,%d font ',11' } "
+               "else { set terminal png size %d,%d }\n",
+            900 * cols, 600 * rows, 900 * cols, 600 * rows);
+    fprintf(g, "set output 'snapshots_%s_%s.png'\nset multiplot layout %d,%d title '%s: %s, stage %s' noenhanced\n", stage, col,
+            rows, cols, sc->name, col, stage);
+    for (int j = 0; j < n; ++j)
+      fprintf(g, "set title 't = %g s'\nplot '%s' skip 2 using 1:2:3 with points pt 7 ps 0.3 lc palette notitle\n", when[j],
+              files[j]);
+    fprintf(g, "unset multiplot\nset output\n");
+  }
+  const int st = pclose(g);
+  if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+    snprintf(warn, len, "gnuplot failed (see %s/snapshot_plots.log)", outdir);
+    return 1;
+  }
+  if (missing) {
+    snprintf(warn, len, "%d requested snapshot time(s) were never reached (after the stage's end?)", missing);
+    return 1;
+  }
+  return 0;
+}
