@@ -143,11 +143,11 @@ static void test_sticking_2d(void **state) {
   const double V = 0.5, t = 0.2;
   double va, vbot, imp, slip;
   run(2, 2.0, V, t, &va, &vbot, &imp, &slip);
-  /* over the second half the base hardly slips on the plate (the plate travels V t/2; the
-   * explicit stick is a viscous tie, slip rate = tangential force dt / m per point:
-   * measured 5 %); the block as a whole
-   * moves with it, give or take the elastic vibration set off when the base caught up */
-  if (fabs(slip) > 0.1 * V * t / 2 || fabs(va - V) > 0.25 * V)
+  /* over the second half the base does not slip on the plate (the plate travels V t/2; the
+   * elastic stick holds each point within T/k of where it stuck: measured 0.2 % of the
+   * plate's travel); the block as a whole moves with it, give or take the elastic
+   * vibration set off when the base caught up */
+  if (fabs(slip) > 0.02 * V * t / 2 || fabs(va - V) > 0.25 * V)
     fail_msg("sticking: slip of the base over the second half %.3g m (expected 0, plate "
              "travel %.3g m), block velocity %.4f (expected the plate's %.4f)",
              slip, V * t / 2, va, V);

@@ -1,0 +1,95 @@
+/* The threaded kernels give the serial answer (issue 11; also the driver of
+ * scripts/check-tsan): a 2D and a 3D scene above MPMC_OMP_MIN points (so P2G, G2P, F-bar, the
+ * stress update and the monitor run their parallel loops) stepped on 1 and on 2 threads;
+ * positions, velocities, stresses and J agree to round-off (the scatter sums in another
+ * order), and neither run trips the monitor. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "test_util.h"
+
+typedef struct {
+  int n;
+  double *x, *v, *s, *J;
+} snap;
+
+static void run(int dim, int nthreads, int fbar, int basis, snap *out) {
+  mpmc_context ctx;
+  mpmc_sim sim;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  TCALL(mpmc_sim_create(ctx, dim, &sim));
+  const double h = dim == 2 ? 0.02 : 0.1;
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1};
+  const double blo[3] = {0, 0, 0}, bhi[3] = {dim == 2 ? 1.3 : 1.0, 0.7, 0.8};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  TCALL(mpmc_sim_set_basis(sim, basis));
+  TCALL(mpmc_sim_set_fbar(sim, fbar));
+  TCALL(mpmc_sim_set_threads(sim, nthreads));
+  int mat, n;
+  TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e6, 0.45, 2000, 8e3, 2e3, 50, &mat));
+  TCALL(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, &n));
+  if (n <= 4096) fail_msg("expected more than MPMC_OMP_MIN = 4096 points, got %d", n);
+  for (int f = 0; f < 2 * dim; ++f)
+    if (f != 1) TCALL(mpmc_sim_add_wall_face(sim, f, f == 2 ? MPMC_WALL_FIXED : MPMC_WALL_SLIP, NULL));
+  const double g[3] = {0, -9.81, 0};
+  TCALL(mpmc_sim_set_gravity(sim, g));
+  double dt;
+  TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
+  for (int s = 0; s < 8; ++s) TCALL(mpmc_sim_step(sim, dt));
+  double *f;
+  out->n = n;
+  const int fields[4] = {MPMC_FIELD_POSITION, MPMC_FIELD_VELOCITY, MPMC_FIELD_STRESS, MPMC_FIELD_J};
+  double **dst[4] = {&out->x, &out->v, &out->s, &out->J};
+  for (int k = 0; k < 4; ++k) {
+    int nc;
+    TCALL(mpmc_sim_get_field(sim, fields[k], &f, &nc));
+    *dst[k] = malloc(sizeof(double) * (size_t)n * nc);
+    memcpy(*dst[k], f, sizeof(double) * (size_t)n * nc);
+  }
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+}
+
+static void compare(const char *what, const double *a, const double *b, size_t len, double scale) {
+  for (size_t i = 0; i < len; ++i)
+    if (!(fabs(a[i] - b[i]) <= 1e-9 * scale))
+      fail_msg("%s[%zu]: 2 threads %.17g, expected the 1-thread value %.17g (tolerance %g)", what, i, b[i], a[i],
+               1e-9 * scale);
+}
+
+static void check(int dim, int fbar, int basis) {
+  snap one, two;
+  run(dim, 1, fbar, basis, &one);
+  run(dim, 2, fbar, basis, &two);
+  const size_t n = (size_t)one.n;
+  compare("x", one.x, two.x, n * dim, 1.0);
+  compare("v", one.v, two.v, n * dim, 1.0);
+  compare("stress", one.s, two.s, n * 6, 1e4);
+  compare("J", one.J, two.J, n, 1.0);
+  free(one.x), free(one.v), free(one.s), free(one.J);
+  free(two.x), free(two.v), free(two.s), free(two.J);
+}
+
+static void test_2d_fbar(void **state) {
+  (void)state;
+  check(2, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2);
+}
+static void test_2d_ugimp_total(void **state) {
+  (void)state;
+  check(2, MPMC_FBAR_TOTAL, MPMC_BASIS_UGIMP);
+}
+static void test_3d_fbar(void **state) {
+  (void)state;
+  check(3, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {cmocka_unit_test(test_2d_fbar), cmocka_unit_test(test_2d_ugimp_total),
+                                     cmocka_unit_test(test_3d_fbar)};
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
