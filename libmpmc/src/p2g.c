@@ -5,16 +5,20 @@
 
 #include "transfer.h"
 
-/* Bucket the points into slabs of MPMC_SLAB_W cells along the grid's longest axis (a
- * counting sort of indices; the particle arrays themselves are not moved, so indices held
+/* Bucket the points into slabs of MPMC_SLAB_W cells along one axis (a counting sort of
+ * indices; the particle arrays themselves are not moved, so indices held
  * by callers and particle sets stay valid). */
 int mpmc_slabs_build(mpmc_sim sim) {
   const mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim;
-  int axis = 0;
-  for (int a = 1; a < d; ++a)
-    if (g->n[a] > g->n[axis]) axis = a;
+  /* the outermost axis of the node numbering (z in 3D, y in 2D): a slab's nodes are then one
+   * contiguous block, and so are its points when they were seeded in lattice order; another
+   * axis only when this one has too few slabs to keep two threads busy */
+  int axis = d - 1;
+  if (g->n[axis] / MPMC_SLAB_W < 8)
+    for (int a = 0; a < d; ++a)
+      if (g->n[a] > g->n[axis]) axis = a;
   const int nslab = g->n[axis] / MPMC_SLAB_W + 1;
   if (p->n > sim->cap_order) {
     int *o = realloc(sim->order, sizeof(int) * (size_t)p->n);
