@@ -12,12 +12,6 @@
 
 #include "transfer.h"
 
-static inline double det_dim(const int DIM, const double *F) {
-  return DIM == 2 ? F[0] * F[3] - F[1] * F[2]
-                  : F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
-                        F[2] * (F[3] * F[7] - F[4] * F[6]);
-}
-
 /* Scatter point q: V^n and V^n j onto its nodes (Algorithm 1, step 3). */
 MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
@@ -26,7 +20,7 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
-  const double dJ = det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
+  const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
   const double Vn = p->vol0[q] * p->J[q] / dJ;
   const double val = sim->fbar == MPMC_FBAR_TOTAL ? p->J[q] : p->Jbar[q] * dJ;
   const double Vv = Vn * val;
@@ -57,7 +51,7 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   double pi = 0.0;
   MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, { pi += w * gjb[node]; });
   double *dF = p->dF + (size_t)q * DIM * DIM;
-  const double r = pi / (p->Jbar[q] * det_dim(DIM, dF));
+  const double r = pi / (p->Jbar[q] * mpmc_det_dim(DIM, dF));
   const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
   for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
   p->Jbar[q] = pi;

@@ -35,10 +35,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, d
   double *dF = p->dF + (size_t)q * DIM * DIM;
   for (int a = 0; a < DIM; ++a)
     for (int b = 0; b < DIM; ++b) dF[a * DIM + b] = (a == b) + dt * L[a][b];
-  const double dJ = DIM == 2 ? dF[0] * dF[3] - dF[1] * dF[2]
-                             : dF[0] * (dF[4] * dF[8] - dF[5] * dF[7]) -
-                                   dF[1] * (dF[3] * dF[8] - dF[5] * dF[6]) +
-                                   dF[2] * (dF[3] * dF[7] - dF[4] * dF[6]);
+  const double dJ = mpmc_det_dim(DIM, dF);
   p->J[q] *= dJ;
   int ok = dJ > 0.0 && isfinite(dJ);
   double *v = p->v + qd;
@@ -66,13 +63,13 @@ static int report(mpmc_sim sim, int q) {
   const int d = sim->dim;
   const double *x = (sim->fbar ? p->xn : p->x) + (size_t)q * d;
   const double *dF = p->dF + (size_t)q * d * d;
-  const double dJ = d == 2 ? dF[0] * dF[3] - dF[1] * dF[2] : NAN;
+  const double dJ = d == 2 ? mpmc_det_dim(2, dF) : mpmc_det_dim(3, dF);
   if (!(p->J[q] > 0.0) || !isfinite(p->J[q]))
     return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
                       "step %lld, t = %g: point %d at (%g, %g, %g) inverted or lost its volume "
                       "(J = %g%s): reduce the time step",
                       (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0,
-                      p->J[q], d == 2 && dJ <= 0 ? ", dJ <= 0" : "");
+                      p->J[q], dJ <= 0 ? ", dJ <= 0" : "");
   return MPMC_ERROR(sim->ctx, MPMC_ERR_OUTSIDE,
                     "step %lld, t = %g: point %d left the grid box at (%g, %g, %g)",
                     (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0);

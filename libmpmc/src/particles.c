@@ -5,19 +5,16 @@
 
 #include "mpmc_impl.h"
 
-static int grow(mpmc_context ctx, double **a, size_t ncomp, int cap) {
-  if (!*a) return MPMC_SUCCESS;
+static int grow_always(mpmc_context ctx, double **a, size_t ncomp, int cap) {
   double *b = realloc(*a, sizeof(double) * ncomp * (size_t)cap);
   MPMC_CHECK(b, ctx, MPMC_ERR_MEMORY, "cannot grow a particle field to %d points", cap);
   *a = b;
   return MPMC_SUCCESS;
 }
 
-static int grow_always(mpmc_context ctx, double **a, size_t ncomp, int cap) {
-  double *b = realloc(*a, sizeof(double) * ncomp * (size_t)cap);
-  MPMC_CHECK(b, ctx, MPMC_ERR_MEMORY, "cannot grow a particle field to %d points", cap);
-  *a = b;
-  return MPMC_SUCCESS;
+/* an optional field grows only if the scene has it */
+static int grow(mpmc_context ctx, double **a, size_t ncomp, int cap) {
+  return *a ? grow_always(ctx, a, ncomp, cap) : MPMC_SUCCESS;
 }
 
 int mpmc_particles_reserve(mpmc_context ctx, mpmc_particles *p, int cap) {

@@ -27,6 +27,13 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights(const int DIM, const int BASIS, const
   pw->node0 = (size_t)base[0] + (size_t)g->n[0] * ((size_t)base[1] + (size_t)g->n[1] * (size_t)base[2]);
 }
 
+/* det of a dim x dim row-major matrix (the relative deformation gradient) */
+MPMC_ALWAYS_INLINE double mpmc_det_dim(const int DIM, const double *F) {
+  return DIM == 2 ? F[0] * F[3] - F[1] * F[2]
+                  : F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+                        F[2] * (F[3] * F[7] - F[4] * F[6]);
+}
+
 /* Loop over the stencil: body sees `node` (linear index), `w` (weight) and `gw[DIM]`
  * (weight gradient). */
 #define MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, body)                                          \
