@@ -108,17 +108,18 @@ module mpmc
     mpmc_sim_get_rigid_gap, mpmc_sim_set_contact_params, mpmc_sim_get_contact_params
   public :: mpmc_sim_add_particles, mpmc_sim_get_num_particles, mpmc_sim_set_particle_forces
   public :: mpmc_sim_add_wall, mpmc_sim_add_wall_face, mpmc_sim_add_wall_box, &
-    mpmc_sim_remove_wall
+    mpmc_sim_add_wall_nodes, mpmc_sim_remove_wall
   public :: mpmc_sim_stable_dt, mpmc_sim_step, mpmc_sim_set_force_dt, mpmc_sim_get_time, &
     mpmc_sim_set_time, mpmc_sim_get_kinetic_energy, mpmc_sim_get_stats
-  public :: mpmc_sim_get_num_particle_sets, mpmc_sim_seed_box, mpmc_sim_seed_polygon, &
-    mpmc_seed_gmsh
+  public :: mpmc_sim_get_num_particle_sets, mpmc_sim_get_num_node_sets, mpmc_sim_seed_box, &
+    mpmc_sim_seed_polygon, mpmc_seed_gmsh
   public :: mpmc_output_write, mpmc_output_destroy, mpmc_free
   ! ---- public procedures: Fortran wrappers (strings, zero-copy arrays) -------------------
   public :: mpmc_error_string, mpmc_context_last_error, mpmc_context_get_last_error
   public :: mpmc_sim_get_field, mpmc_sim_restore_field, mpmc_sim_get_material_ids, &
     mpmc_sim_get_user_state
   public :: mpmc_sim_add_particle_set, mpmc_sim_get_particle_set, mpmc_sim_find_particle_set
+  public :: mpmc_sim_add_node_set, mpmc_sim_get_node_set, mpmc_sim_find_node_set
   public :: mpmc_output_create, mpmc_sim_checkpoint_write, mpmc_sim_checkpoint_read
   public :: mpmc_workflow_run, mpmc_workflow_resume
   public :: mpmc_c_str
@@ -435,6 +436,14 @@ module mpmc
       integer(c_int), intent(out) :: id
       integer(c_int) :: ierr
     end function
+    function mpmc_sim_add_wall_nodes(sim, set, kind, axis, side, id) &
+        bind(C, name='mpmc_sim_add_wall_nodes') result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: set, kind, axis, side
+      integer(c_int), intent(out) :: id
+      integer(c_int) :: ierr
+    end function
     function mpmc_sim_remove_wall(sim, id) bind(C, name='mpmc_sim_remove_wall') result(ierr)
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
@@ -594,6 +603,43 @@ module mpmc
     end function
     function mpmc_sim_find_particle_set_c(sim, name, id) &
         bind(C, name='mpmc_sim_find_particle_set') result(ierr)
+      import :: c_int, c_char, mpmc_sim
+      type(mpmc_sim), value :: sim
+      character(kind=c_char), intent(in) :: name(*)
+      integer(c_int), intent(out) :: id
+      integer(c_int) :: ierr
+    end function
+
+    ! ---- node sets ------------------------------------------------------------------------
+    function mpmc_sim_add_node_set_c(sim, name, n, ijk, id) &
+        bind(C, name='mpmc_sim_add_node_set') result(ierr)
+      import :: c_int, c_char, mpmc_sim
+      type(mpmc_sim), value :: sim
+      character(kind=c_char), intent(in) :: name(*)
+      integer(c_int), value :: n
+      integer(c_int), intent(in) :: ijk(*)
+      integer(c_int), intent(out) :: id
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_num_node_sets(sim, n) &
+        bind(C, name='mpmc_sim_get_num_node_sets') result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), intent(out) :: n
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_node_set_c(sim, id, name, n, ijk) &
+        bind(C, name='mpmc_sim_get_node_set') result(ierr)
+      import :: c_int, c_ptr, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: id
+      type(c_ptr), intent(out) :: name
+      integer(c_int), intent(out) :: n
+      type(c_ptr), intent(out) :: ijk
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_find_node_set_c(sim, name, id) &
+        bind(C, name='mpmc_sim_find_node_set') result(ierr)
       import :: c_int, c_char, mpmc_sim
       type(mpmc_sim), value :: sim
       character(kind=c_char), intent(in) :: name(*)
@@ -900,6 +946,49 @@ contains
     integer(c_int) :: ierr
     ierr = mpmc_sim_find_particle_set_c(sim, mpmc_c_str(name), id)
   end function mpmc_sim_find_particle_set
+
+  ! ---- node sets ----------------------------------------------------------------------------
+
+  !> Add (or replace) the node set `name`: ijk(dim, n) holds the nodes' 0-based integer
+  !> coordinates (node (i, j, k) sits at lo + (i, j, k) h).
+  function mpmc_sim_add_node_set(sim, name, ijk, id) result(ierr)
+    type(mpmc_sim), intent(in) :: sim
+    character(*), intent(in) :: name
+    integer(c_int), intent(in), contiguous :: ijk(:, :)
+    integer(c_int), intent(out) :: id
+    integer(c_int) :: ierr
+    ierr = mpmc_sim_add_node_set_c(sim, mpmc_c_str(name), int(size(ijk, 2), c_int), ijk, id)
+  end function mpmc_sim_add_node_set
+
+  !> Node set `id`: its name (a copy) and its nodes ijk(dim, n) (borrowed, no copy).
+  function mpmc_sim_get_node_set(sim, id, name, ijk) result(ierr)
+    type(mpmc_sim), intent(in) :: sim
+    integer(c_int), intent(in) :: id
+    character(len=:), allocatable, intent(out) :: name
+    integer(c_int), pointer, intent(out) :: ijk(:, :)
+    integer(c_int) :: ierr, n, dim
+    type(c_ptr) :: pname, pijk
+    nullify (ijk)
+    name = ''
+    ierr = mpmc_sim_get_dim(sim, dim)
+    if (ierr /= MPMC_SUCCESS) return
+    ierr = mpmc_sim_get_node_set_c(sim, id, pname, n, pijk)
+    if (ierr /= MPMC_SUCCESS) return
+    name = f_string(pname)
+    if (c_associated(pijk) .and. n > 0) then
+      call c_f_pointer(pijk, ijk, [dim, n])
+    else
+      allocate (ijk(dim, 0)) ! an empty set
+    end if
+  end function mpmc_sim_get_node_set
+
+  function mpmc_sim_find_node_set(sim, name, id) result(ierr)
+    type(mpmc_sim), intent(in) :: sim
+    character(*), intent(in) :: name
+    integer(c_int), intent(out) :: id
+    integer(c_int) :: ierr
+    ierr = mpmc_sim_find_node_set_c(sim, mpmc_c_str(name), id)
+  end function mpmc_sim_find_node_set
 
   ! ---- output and checkpoints ------------------------------------------------------------
 

@@ -12,7 +12,7 @@ program t111_fields_f
   integer(c_int) :: mat, first, ierr, q, sid, nsets
   real(c_double) :: x0(2, 4), ke
   real(c_double), pointer :: x(:, :), v(:, :), m(:), x1d(:), s(:, :)
-  integer(c_int), pointer :: ids(:), idx(:)
+  integer(c_int), pointer :: ids(:), idx(:), nodes(:, :)
   character(len=:), allocatable :: name
   type(c_ptr) :: px
   integer :: nfail
@@ -93,6 +93,23 @@ program t111_fields_f
   ierr = mpmc_sim_add_particle_set(sim, 'bad', [7_c_int], sid)
   call expect_int('set with an index out of range', MPMC_ERR_ARG, ierr)
   call expect_has('message of the bad set', mpmc_context_last_error(ctx), 'idx[0] = 7 outside [0, 4)')
+
+  ! node sets: ijk(dim, n), 0-based node coordinates, borrowed; a wall on one
+  call ok(mpmc_sim_add_node_set(sim, 'base', reshape([0_c_int, 0_c_int, 1_c_int, 0_c_int], [2, 2]), sid), &
+          'add node set')
+  call ok(mpmc_sim_get_num_node_sets(sim, nsets), 'number of node sets')
+  call expect_int('number of node sets', 1, nsets)
+  call ok(mpmc_sim_find_node_set(sim, 'base', q), 'find node set')
+  call expect_int('found node set id', sid, q)
+  call ok(mpmc_sim_get_node_set(sim, sid, name, nodes), 'get node set')
+  call check(name == 'base', 'node set name "base", got "'//name//'"')
+  call expect_int('node set rows', 2, size(nodes, 1))
+  call expect_int('node set size', 2, size(nodes, 2))
+  call expect_int('node set ijk(1, 2)', 1, nodes(1, 2))
+  call ok(mpmc_sim_add_wall_nodes(sim, sid, MPMC_WALL_FIXED, 0_c_int, -1_c_int, q), 'wall on a node set')
+  ierr = mpmc_sim_find_node_set(sim, 'top', q)
+  call expect_int('unknown node set', MPMC_ERR_ARG, ierr)
+  call expect_has('message of the unknown node set', mpmc_context_last_error(ctx), "no node set named 'top'")
 
   deallocate (name) ! main-program variables are not freed automatically
   call ok(mpmc_sim_destroy(sim), 'destroy sim')

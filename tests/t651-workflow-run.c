@@ -6,7 +6,9 @@
  * - a box scene must not load libgmsh (/proc/self/maps);
  * - `mpmc check` writes nothing; `mpmc resume` from the checkpoint between the stages ends
  *   in the same state;
- * - slope_2d with the standard formulation (F-bar off) locks and does not run out. */
+ * - slope_2d with the standard formulation (F-bar off) locks and does not run out;
+ * - a wall on a gmsh boundary group's node set (Cook's "clamp", the nodes x = 0, y = 0..44)
+ *   gives the same run as a box wall on those nodes; an unknown set is named in the error. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -142,11 +144,37 @@ static void test_slope_locks_without_fbar(void **state) {
   if (!(r < 1.0)) fail_msg("slope_2d without F-bar: expected a locked slope, run-out < 1 m, got %g m", r);
 }
 
+static int run_cook(const char *wall, const char *out) {
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  const char *sets[] = {"grid.cell_size=4", "plots=false", "stages.0.end={time: 2}", wall};
+  const int rc = mpmc_workflow_run(ctx, MPMC_SOURCE_DIR "/workflows/cook_membrane.yaml", out, 4, sets,
+                                   MPMC_WORKFLOW_FORCE | MPMC_WORKFLOW_QUIET);
+  if (rc && !strstr(mpmc_context_last_error(ctx), "nosuch"))
+    fail_msg("Cook with %s: %s", wall, mpmc_context_last_error(ctx));
+  if (rc && !strstr(mpmc_context_last_error(ctx), "stages.0.walls.0.set"))
+    fail_msg("unknown node set: the message '%s' does not name the scene key", mpmc_context_last_error(ctx));
+  mpmc_context_destroy(&ctx);
+  return rc;
+}
+
+static void test_node_set_wall(void **state) {
+  (void)state;
+  assert_int_equal(run_cook("stages.0.walls.0={set: clamp, kind: fixed}", DIR "/out-cook-set"), 0);
+  assert_int_equal(run_cook("stages.0.walls.0={lo: [0, 0], hi: [0, 44], kind: fixed}", DIR "/out-cook-box"), 0);
+  const double a = json_number(DIR "/out-cook-set/summary.json", "tip_displacement_y");
+  const double b = json_number(DIR "/out-cook-box/summary.json", "tip_displacement_y");
+  if (!(a > 1e-3) || a != b) fail_msg("tip u_y: node-set wall %.17g, box wall %.17g (expected equal, > 1 mm)", a, b);
+  if (run_cook("stages.0.walls.0={set: nosuch, kind: fixed}", DIR "/out-cook-bad") == 0)
+    fail_msg("a wall on an unknown node set: expected a failure");
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_free_fall),
       cmocka_unit_test(test_check_and_resume),
       cmocka_unit_test(test_slope_locks_without_fbar),
+      cmocka_unit_test(test_node_set_wall),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

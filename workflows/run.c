@@ -279,9 +279,14 @@ static int stage_setup(wf_run *w, int i) {
       WF_TRY(w, mpmc_sim_add_wall_face(sim, wl->face, wl->kind, &id), "stages.%d.walls.%d", i, k);
     else if (wl->form == 1)
       WF_TRY(w, mpmc_sim_add_wall(sim, wl->axis, wl->side, wl->position, wl->kind, &id), "stages.%d.walls.%d", i, k);
-    else
+    else if (wl->form == 2)
       WF_TRY(w, mpmc_sim_add_wall_box(sim, wl->lo, wl->hi, wl->kind, wl->axis, wl->side, &id),
              "stages.%d.walls.%d", i, k);
+    else {
+      int set = -1;
+      WF_TRY(w, mpmc_sim_find_node_set(sim, wl->set, &set), "stages.%d.walls.%d.set", i, k);
+      WF_TRY(w, mpmc_sim_add_wall_nodes(sim, set, wl->kind, wl->axis, wl->side, &id), "stages.%d.walls.%d", i, k);
+    }
     w->wall_ids[base + k] = id;
   }
   for (int k = 0; k < s->nremove; ++k) {

@@ -735,7 +735,7 @@ static int read_walls(rd *r, const wf_node *list, const char *path, const wf_sce
   s->nwalls = list->n;
   s->walls = calloc((size_t)list->n + 1, sizeof *s->walls);
   if (!s->walls) return fail_at(r, list, path, "out of memory");
-  static const char *const keys[] = {"name", "kind", "face", "axis", "side", "position", "lo", "hi", NULL};
+  static const char *const keys[] = {"name", "kind", "face", "axis", "side", "position", "lo", "hi", "set", NULL};
   static const char *const sides[] = {"below", "above", NULL};
   for (int i = 0; i < list->n; ++i) {
     wf_wall *w = &s->walls[i];
@@ -764,8 +764,15 @@ static int read_walls(rd *r, const wf_node *list, const char *path, const wf_sce
       if (get_enum(r, n, p, "axis", w->kind != MPMC_WALL_FIXED, 0, axis_words, &w->axis)) return -1;
       if (get_enum(r, n, p, "side", w->kind == MPMC_WALL_SEPARABLE, 0, sides, &side)) return -1;
       w->side = side ? 1 : -1;
+    } else if (map_get(n, "set")) {
+      /* the nodes of a gmsh boundary group (node set); checked against the mesh at run time */
+      w->form = 3;
+      if (get_str(r, n, p, "set", 1, "", w->set, sizeof w->set)) return -1;
+      if (get_enum(r, n, p, "axis", w->kind != MPMC_WALL_FIXED, 0, axis_words, &w->axis)) return -1;
+      if (get_enum(r, n, p, "side", w->kind == MPMC_WALL_SEPARABLE, 0, sides, &side)) return -1;
+      w->side = side ? 1 : -1;
     } else {
-      return fail_at(r, n, p, "a wall needs face, or axis+position+side, or a box lo+hi");
+      return fail_at(r, n, p, "a wall needs face, or axis+position+side, or a box lo+hi, or a node set");
     }
     join(full, sizeof full, p, "axis");
     if (w->axis >= sc->dim) return fail_at(r, map_get(n, "axis"), full, "no axis z in 2D");

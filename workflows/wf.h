@@ -80,9 +80,10 @@ typedef struct {
 typedef struct {
   char name[WF_NAME];       /* "" when unnamed                                      */
   int kind;                 /* mpmc_wall_kind                                       */
-  int form;                 /* 0 face, 1 plane, 2 box                               */
+  int form;                 /* 0 face, 1 plane, 2 box, 3 node set                   */
   int face, axis, side;
   double position, lo[3], hi[3];
+  char set[WF_NAME];        /* form 3: a node set (gmsh boundary group)             */
 } wf_wall;
 
 typedef struct {

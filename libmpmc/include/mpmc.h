@@ -178,6 +178,9 @@ int mpmc_sim_add_wall_face(mpmc_sim sim, int face, int kind, int *id);
  * -side (side -1: material is at larger x[axis]). */
 int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, int kind, int axis,
                           int side, int *id);
+/* Constrain the nodes of a node set (mpmc_sim_add_node_set, or a gmsh boundary group);
+ * axis and side as for a box.  Plain constraint: no ghost mirroring. */
+int mpmc_sim_add_wall_nodes(mpmc_sim sim, int set, int kind, int axis, int side, int *id);
 int mpmc_sim_remove_wall(mpmc_sim sim, int id);
 
 /* ---- time stepping ---------------------------------------------------------- */
@@ -238,6 +241,16 @@ int mpmc_sim_get_particle_set(const mpmc_sim sim, int id, const char **name, int
                               const int **idx);
 int mpmc_sim_find_particle_set(const mpmc_sim sim, const char *name, int *id);
 
+/* ---- named node sets (sets.c) ------------------------------------------------------ */
+/* Grid nodes by integer coordinates ijk[n*dim]: node (i, j, k) sits at lo + (i, j, k) h,
+ * 0 <= i <= cells along each axis.  gmsh seeding makes one per boundary group (the nodes
+ * whose cell of influence, a square/cube of side h centred on the node, touches the group).
+ * Adding a set with an existing name replaces it.  Needs the grid; kept in checkpoints. */
+int mpmc_sim_add_node_set(mpmc_sim sim, const char *name, int n, const int *ijk, int *id);
+int mpmc_sim_get_num_node_sets(const mpmc_sim sim, int *n);
+int mpmc_sim_get_node_set(const mpmc_sim sim, int id, const char **name, int *n, const int **ijk);
+int mpmc_sim_find_node_set(const mpmc_sim sim, const char *name, int *id);
+
 /* ---- seeding without gmsh (seed.c) --------------------------------------------- */
 /* ppc points per cell per axis on the sim's grid lattice, kept where they fall inside
  * the region; volume (h/ppc)^dim each.  *first / *count may be NULL. */
@@ -254,7 +267,9 @@ typedef enum {
 } mpmc_seed_mode;
 /* Mesh a .geo (or read a .msh) and add points for the physical group `region` (surface in
  * 2D, volume in 3D).  Points near the boundary physical groups (curves in 2D, surfaces in
- * 3D) and physical point groups become particle sets named after the groups. */
+ * 3D) and physical point groups become particle sets named after the groups, and node sets
+ * of the grid nodes near them (for walls: mpmc_sim_add_wall_nodes).  On failure nothing is
+ * added. */
 int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
                    int material, int *first, int *count);
 

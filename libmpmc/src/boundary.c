@@ -4,7 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "mpmc_impl.h"
+#include "sets.h"
 
 static int push_wall(mpmc_sim sim, const mpmc_wall *w, int *id) {
   if (sim->nwall == sim->capwall) {
@@ -42,7 +42,7 @@ int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, int kin
   MPMC_CALL(check_kind_axis_side(sim, kind, axis, side));
   MPMC_CHECK(isfinite(position), sim->ctx, MPMC_ERR_ARG, "wall position = %g is not finite",
              position);
-  mpmc_wall w = {.active = 1, .kind = kind, .axis = axis, .side = side};
+  mpmc_wall w = {.active = 1, .kind = kind, .axis = axis, .side = side, .nodeset = -1};
   for (int a = 0; a < 3; ++a) {
     w.lo[a] = -INFINITY;
     w.hi[a] = INFINITY;
@@ -78,13 +78,32 @@ int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, int 
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CALL(check_kind_axis_side(sim, kind, axis, side));
   MPMC_CHECK(lo && hi, sim->ctx, MPMC_ERR_ARG, "wall box lo/hi arrays are NULL");
-  mpmc_wall w = {.active = 1, .kind = kind, .axis = axis, .side = side};
+  mpmc_wall w = {.active = 1, .kind = kind, .axis = axis, .side = side, .nodeset = -1};
   for (int a = 0; a < 3; ++a) {
     w.lo[a] = a < sim->dim ? lo[a] : -INFINITY;
     w.hi[a] = a < sim->dim ? hi[a] : INFINITY;
     if (a < sim->dim)
       MPMC_CHECK(!isnan(lo[a]) && !isnan(hi[a]) && hi[a] >= lo[a], sim->ctx, MPMC_ERR_ARG,
                  "wall box axis %d: hi = %g must be >= lo = %g", a, hi[a], lo[a]);
+  }
+  return push_wall(sim, &w, id);
+}
+
+/**
+ * @brief Constrain the nodes of node set `set` (e.g. a gmsh boundary group).
+ * @param axis, side as for mpmc_sim_add_wall_box: the constrained component for SLIP and
+ *        SEPARABLE, and for SEPARABLE the side the material lies on
+ */
+int mpmc_sim_add_wall_nodes(mpmc_sim sim, int set, int kind, int axis, int side, int *id) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CALL(check_kind_axis_side(sim, kind, axis, side));
+  const int ns = sim->node_sets ? sim->node_sets->n : 0;
+  MPMC_CHECK(set >= 0 && set < ns, sim->ctx, MPMC_ERR_ARG, "node set id %d does not exist (%d sets)",
+             set, ns);
+  mpmc_wall w = {.active = 1, .kind = kind, .axis = axis, .side = side, .nodeset = set};
+  for (int a = 0; a < 3; ++a) {
+    w.lo[a] = -INFINITY;
+    w.hi[a] = INFINITY;
   }
   return push_wall(sim, &w, id);
 }
@@ -122,6 +141,18 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
       bits = 1u << w->axis;
     else
       bits = (w->side < 0 ? 8u : 64u) << w->axis;
+    if (w->nodeset >= 0) { /* the set's nodes, no mirroring (not a plane) */
+      MPMC_CHECK(sim->node_sets && w->nodeset < sim->node_sets->n, sim->ctx, MPMC_ERR_STATE,
+                 "wall %d: its node set %d no longer exists", wi, w->nodeset);
+      const mpmc_set *ns = &sim->node_sets->s[w->nodeset];
+      for (int q = 0; q < ns->n; ++q) {
+        const int *c = ns->idx + (size_t)q * sim->dim;
+        size_t node = 0;
+        for (int a = sim->dim - 1; a >= 0; --a) node = node * (size_t)g->n[a] + (size_t)(c[a] + MPMC_GHOST);
+        g->fixed[node] |= bits;
+      }
+      continue;
+    }
     int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < sim->dim; ++a) {
       const double l = (w->lo[a] - g->origin[a]) * g->inv_h, u = (w->hi[a] - g->origin[a]) * g->inv_h;

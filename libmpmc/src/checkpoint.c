@@ -337,8 +337,16 @@ static int write_walls(hid_t f, const mpmc_sim sim) {
     r[0] = s->active, r[1] = s->kind, r[2] = s->axis, r[3] = s->side;
     for (int a = 0; a < 3; ++a) r[4 + a] = s->lo[a], r[7 + a] = s->hi[a];
   }
-  const herr_t st =
+  herr_t st =
       mpmc_h5_dataset_write(f, "walls", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)nw, WALLCOLS, w);
+  /* walls on node sets: the set ids, in a dataset of their own so that checkpoints without
+   * it (written before node sets existed) still read */
+  int *ns = malloc(sizeof(int) * (size_t)(nw > 0 ? nw : 1));
+  if (!ns) st = -1;
+  for (int i = 0; i < nw && ns; ++i) ns[i] = sim->walls[i].nodeset;
+  if (st >= 0)
+    st = mpmc_h5_dataset_write(f, "walls_nodeset", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)nw, 0, ns);
+  free(ns);
   free(w);
   return st < 0 ? -1 : 0;
 }
@@ -368,8 +376,19 @@ static int read_walls(hid_t f, mpmc_sim sim) {
     mpmc_wall *s = &sim->walls[i];
     s->active = (int)r[0], s->kind = (int)r[1], s->axis = (int)r[2], s->side = (int)r[3];
     for (int a = 0; a < 3; ++a) s->lo[a] = r[4 + a], s->hi[a] = r[7 + a];
+    s->nodeset = -1;
   }
   free(w);
+  if (exists(f, "walls_nodeset")) {
+    int *ns = malloc(sizeof(int) * (size_t)(nw > 0 ? nw : 1));
+    MPMC_CHECK(ns, ctx, MPMC_ERR_MEMORY, "cannot allocate %d wall node-set ids", nw);
+    if (read_dataset(f, "walls_nodeset", H5T_NATIVE_INT, (size_t)nw, 0, ns) < 0) {
+      free(ns);
+      return MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /walls_nodeset: not [%d] integers", nw);
+    }
+    for (int i = 0; i < nw; ++i) sim->walls[i].nodeset = ns[i];
+    free(ns);
+  }
   sim->nwall = nw;
   sim->walls_dirty = 1;
   return MPMC_SUCCESS;
@@ -377,16 +396,19 @@ static int read_walls(hid_t f, mpmc_sim sim) {
 
 /* ---- block: particle sets ------------------------------------------------------------------ */
 
-static int write_sets(hid_t f, const mpmc_sim sim) {
-  hid_t g = H5Gcreate2(f, "sets", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+/* One group per kind of set: a dataset per set ([n] point indices, or [n][dim] node
+ * coordinates), named by number, with the set's name as an attribute. */
+static int write_set_group(hid_t f, const char *gname, const struct mpmc_sets_s *S, int ncomp) {
+  hid_t g = H5Gcreate2(f, gname, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) return -1;
-  const int ns = sim->sets ? sim->sets->n : 0;
+  const int ns = S ? S->n : 0;
   herr_t st = mpmc_h5_attr_write(g, "count", H5T_NATIVE_INT, 1, &ns);
   for (int k = 0; k < ns && st >= 0; ++k) {
-    const mpmc_set *s = &sim->sets->s[k];
+    const mpmc_set *s = &S->s[k];
     char name[32];
     snprintf(name, sizeof name, "%06d", k); /* set names may hold '/' : kept as attributes */
-    st |= mpmc_h5_dataset_write(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)s->n, 0, s->idx);
+    st |= mpmc_h5_dataset_write(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)s->n,
+                                ncomp > 1 ? (size_t)ncomp : 0, s->idx);
     hid_t ds = st >= 0 ? H5Dopen2(g, name, H5P_DEFAULT) : -1;
     if (ds < 0 || mpmc_h5_attr_write_string(ds, "name", s->name) < 0) st = -1;
     if (ds >= 0) H5Dclose(ds);
@@ -395,13 +417,18 @@ static int write_sets(hid_t f, const mpmc_sim sim) {
   return st < 0 ? -1 : 0;
 }
 
-static int read_sets(hid_t f, mpmc_sim sim) {
+static int write_sets(hid_t f, const mpmc_sim sim) {
+  if (write_set_group(f, "sets", sim->sets, 1) < 0) return -1;
+  return write_set_group(f, "node_sets", sim->node_sets, sim->dim);
+}
+
+static int read_set_group(hid_t f, mpmc_sim sim, const char *gname, int ncomp) {
   mpmc_context ctx = sim->ctx;
-  hid_t g = exists(f, "sets") ? H5Gopen2(f, "sets", H5P_DEFAULT) : -1;
-  MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /sets group");
+  hid_t g = exists(f, gname) ? H5Gopen2(f, gname, H5P_DEFAULT) : -1;
+  MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /%s group", gname);
   int ns = -1, err = MPMC_SUCCESS;
   if (mpmc_h5_attr_read(g, "count", H5T_NATIVE_INT, 1, &ns) < 0 || ns < 0)
-    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /sets: bad count %d", ns);
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /%s: bad count %d", gname, ns);
   for (int k = 0; k < ns && !err; ++k) {
     char dname[32];
     snprintf(dname, sizeof dname, "%06d", k);
@@ -412,19 +439,28 @@ static int read_sets(hid_t f, mpmc_sim sim) {
       hid_t sp = H5Dget_space(ds);
       n = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
       if (sp >= 0) H5Sclose(sp);
-      if (mpmc_h5_attr_read_string(ds, "name", &name) < 0) n = -1;
+      if (mpmc_h5_attr_read_string(ds, "name", &name) < 0 || n % ncomp != 0) n = -1;
       H5Dclose(ds);
     }
     int *idx = n >= 0 && n < INT32_MAX ? malloc(sizeof(int) * (size_t)(n > 0 ? n : 1)) : NULL;
-    if (!idx || read_dataset(g, dname, H5T_NATIVE_INT, (size_t)n, 0, idx) < 0)
-      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /sets/%s: unreadable", dname);
+    const size_t rows = n > 0 ? (size_t)n / (size_t)ncomp : 0;
+    if (!idx || read_dataset(g, dname, H5T_NATIVE_INT, rows, ncomp > 1 ? (size_t)ncomp : 0, idx) < 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /%s/%s: unreadable", gname, dname);
+    else if (ncomp == 1)
+      err = mpmc_sim_add_particle_set(sim, name, (int)rows, idx, NULL);
     else
-      err = mpmc_sim_add_particle_set(sim, name, (int)n, idx, NULL);
+      err = mpmc_sim_add_node_set(sim, name, (int)rows, idx, NULL);
     free(idx);
     free(name);
   }
   H5Gclose(g);
   return err;
+}
+
+static int read_sets(hid_t f, mpmc_sim sim) {
+  MPMC_CALL(read_set_group(f, sim, "sets", 1));
+  /* checkpoints written before node sets existed have none */
+  return exists(f, "node_sets") ? read_set_group(f, sim, "node_sets", sim->dim) : MPMC_SUCCESS;
 }
 
 /* ---- block: rigid bodies (contact_barrier.c) ---------------------------------------------- */

@@ -141,6 +141,7 @@ typedef struct {
   int active;
   int kind, axis, side;
   double lo[3], hi[3]; /* the constrained region (infinite in unbounded directions) */
+  int nodeset;         /* >= 0: the wall constrains this node set instead of a region */
 } mpmc_wall;
 
 /* A wall on a node plane, unbounded along the other axes: the ghost nodes beyond it take the
@@ -200,6 +201,7 @@ struct mpmc_sim_s {
   int nslab, slab_axis, cap_order, cap_slab;
   struct mpmc_bodies_s *bodies; /* rigid bodies and barrier contact (contact_barrier.c) */
   struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
+  struct mpmc_sets_s *node_sets; /* named grid node sets (sets.c)                     */
   mpmc_monitor monitor;         /* energy check after each step (monitor.c)           */
 };
 

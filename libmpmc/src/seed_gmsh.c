@@ -5,7 +5,8 @@
  * elements' Gauss points carrying weight * det J as volume (summing to the mesh's area or
  * volume to round-off).  Every lower-dimensional physical group becomes a particle set of
  * the new points near it (curves/surfaces: within half a point spacing; points: the
- * nearest point). */
+ * nearest point) and a node set of the grid nodes near it (within half a cell; points: the
+ * nearest node), both named after the group. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -557,82 +558,220 @@ static int seed_quadrature(session *s, mpmc_sim sim, int ptag, const char *regio
   return err;
 }
 
-/* Points [first, first+count) near a boundary group or, for a point group,
- * the nearest point to each of its vertices, as the particle set `name`. */
-static int make_set(mpmc_sim sim, const simplices *B, const char *name, int first, int count,
-                    double spacing) {
+/* The points [first, first+count) bucketed by grid cell (a counting sort), so that the
+ * points near an element are found without scanning them all. */
+typedef struct {
+  int first, count;
+  long nc[3];   /* cells per axis (physical box)      */
+  int *start;   /* [ncell + 1] offsets into pts        */
+  int *pts;     /* [count] point indices, by cell      */
+} buckets;
+
+static long cell_of(const mpmc_grid *g, int a, double x, long nc) {
+  long c = (long)floor((x - g->lo[a]) * g->inv_h);
+  return c < 0 ? 0 : (c >= nc ? nc - 1 : c);
+}
+
+static int buckets_build(mpmc_sim sim, int first, int count, buckets *bk) {
+  const mpmc_grid *g = &sim->grid;
   const int d = sim->dim;
+  size_t ncell = 1;
+  bk->first = first, bk->count = count;
+  for (int a = 0; a < 3; ++a) {
+    bk->nc[a] = a < d ? g->n[a] - 1 - 2 * MPMC_GHOST : 1;
+    ncell *= (size_t)bk->nc[a];
+  }
+  bk->start = calloc(ncell + 1, sizeof(int));
+  bk->pts = malloc(sizeof(int) * (size_t)(count > 0 ? count : 1));
+  int *cell = malloc(sizeof(int) * (size_t)(count > 0 ? count : 1));
+  if (!bk->start || !bk->pts || !cell) {
+    free(cell);
+    return MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "gmsh: cannot bucket %d points", count);
+  }
+  for (int q = 0; q < count; ++q) {
+    const double *x = sim->p.x + (size_t)(first + q) * d;
+    long c = 0;
+    for (int a = d - 1; a >= 0; --a) c = c * bk->nc[a] + cell_of(g, a, x[a], bk->nc[a]);
+    cell[q] = (int)c;
+    bk->start[c + 1]++;
+  }
+  for (size_t c = 0; c < ncell; ++c) bk->start[c + 1] += bk->start[c];
+  for (int q = 0; q < count; ++q) bk->pts[bk->start[cell[q]]++] = first + q;
+  for (size_t c = ncell; c > 0; --c) bk->start[c] = bk->start[c - 1];
+  bk->start[0] = 0;
+  free(cell);
+  return MPMC_SUCCESS;
+}
+
+static void buckets_free(buckets *bk) {
+  free(bk->start);
+  free(bk->pts);
+}
+
+/* Half-width of the band that a boundary element claims: a point (node) belongs when its
+ * tributary square/cube of side `spacing` touches the element, i.e. its distance is at most
+ * spacing/2 * |n|_1 for the element's unit normal n (half a spacing for axis-aligned
+ * boundaries, spacing/sqrt(2) at 45 degrees). */
+static double band(const simplices *B, const double *v, double spacing) {
+  double nrm[3] = {0, 0, 0};
+  if (B->nv == 2) {
+    nrm[0] = -(v[4] - v[1]), nrm[1] = v[3] - v[0];
+  } else {
+    double u[3], w[3];
+    for (int k = 0; k < 3; ++k) u[k] = v[3 + k] - v[k], w[k] = v[6 + k] - v[k];
+    nrm[0] = u[1] * w[2] - u[2] * w[1], nrm[1] = u[2] * w[0] - u[0] * w[2],
+    nrm[2] = u[0] * w[1] - u[1] * w[0];
+  }
+  const double len = sqrt(dot3(nrm, nrm));
+  const double l1 = len > 0 ? (fabs(nrm[0]) + fabs(nrm[1]) + fabs(nrm[2])) / len : 1.0;
+  return 0.5 * spacing * l1 * (1 + 1e-6);
+}
+
+static double dist2_element(const simplices *B, const double *v, const double *p) {
+  return B->nv == 2 ? dist2_segment(v, v + 3, p) : dist2_triangle(v, v + 3, v + 6, p);
+}
+
+/* Element e's bounding box grown by tol. */
+static void element_box(const simplices *B, const double *v, int d, double tol, double *lo,
+                        double *hi) {
+  for (int a = 0; a < 3; ++a) lo[a] = INFINITY, hi[a] = -INFINITY;
+  for (int k = 0; k < B->nv; ++k)
+    for (int a = 0; a < d; ++a) {
+      if (v[3 * k + a] - tol < lo[a]) lo[a] = v[3 * k + a] - tol;
+      if (v[3 * k + a] + tol > hi[a]) hi[a] = v[3 * k + a] + tol;
+    }
+}
+
+/* The points near a boundary group or, for a point group, the nearest point to each of its
+ * vertices: their indices in *idx (malloc'ed), their number in *n. */
+static int group_points(mpmc_sim sim, const simplices *B, const char *name, const buckets *bk,
+                        double spacing, int **idx, int *n) {
+  const int d = sim->dim, first = bk->first, count = bk->count;
+  const mpmc_grid *g = &sim->grid;
   const double *x = sim->p.x;
-  unsigned char *in = calloc((size_t)count, 1);
+  unsigned char *in = calloc((size_t)(count > 0 ? count : 1), 1);
   MPMC_CHECK(in, sim->ctx, MPMC_ERR_MEMORY, "gmsh: cannot allocate set '%s'", name);
-  if (B->nv == 1) {
-    for (size_t e = 0; e < B->n; ++e) {
+  for (size_t e = 0; e < B->n; ++e) {
+    const double *v = B->v + 3 * e * (size_t)B->nv;
+    if (B->nv == 1) { /* few vertices: a scan of the points each */
       double best = INFINITY;
       int arg = -1;
       for (int q = 0; q < count; ++q) {
         double r = 0;
         for (int a = 0; a < d; ++a) {
-          const double c = x[(size_t)(first + q) * d + a] - B->v[3 * e + a];
+          const double c = x[(size_t)(first + q) * d + a] - v[a];
           r += c * c;
         }
         if (r < best) best = r, arg = q;
       }
       if (arg >= 0) in[arg] = 1;
+      continue;
     }
-  } else {
-    for (size_t e = 0; e < B->n; ++e) {
-      const double *v = B->v + 3 * e * (size_t)B->nv;
-      /* a point belongs when its tributary cell (a square/cube of side `spacing`) touches
-       * the element: distance <= spacing/2 * |n|_1 for the element's unit normal n, i.e.
-       * half a spacing for axis-aligned boundaries, spacing/sqrt(2) at 45 degrees */
-      double nrm[3] = {0, 0, 0};
-      if (B->nv == 2) {
-        nrm[0] = -(v[4] - v[1]), nrm[1] = v[3] - v[0];
-      } else {
-        double u[3], w[3];
-        for (int k = 0; k < 3; ++k) u[k] = v[3 + k] - v[k], w[k] = v[6 + k] - v[k];
-        nrm[0] = u[1] * w[2] - u[2] * w[1], nrm[1] = u[2] * w[0] - u[0] * w[2],
-        nrm[2] = u[0] * w[1] - u[1] * w[0];
-      }
-      const double len = sqrt(dot3(nrm, nrm));
-      const double l1 = len > 0 ? (fabs(nrm[0]) + fabs(nrm[1]) + fabs(nrm[2])) / len : 1.0;
-      const double tol = 0.5 * spacing * l1 * (1 + 1e-6), tol2 = tol * tol;
-      double lo[3], hi[3];
-      for (int a = 0; a < 3; ++a) lo[a] = INFINITY, hi[a] = -INFINITY;
-      for (int k = 0; k < B->nv; ++k)
-        for (int a = 0; a < d; ++a) {
-          if (v[3 * k + a] - tol < lo[a]) lo[a] = v[3 * k + a] - tol;
-          if (v[3 * k + a] + tol > hi[a]) hi[a] = v[3 * k + a] + tol;
-        }
-      for (int q = 0; q < count; ++q) {
-        if (in[q]) continue;
-        double p[3] = {0, 0, 0};
-        int inside = 1;
-        for (int a = 0; a < d; ++a) {
-          p[a] = x[(size_t)(first + q) * d + a];
-          inside &= p[a] >= lo[a] && p[a] <= hi[a];
-        }
-        if (!inside) continue;
-        const double r = B->nv == 2 ? dist2_segment(v, v + 3, p) : dist2_triangle(v, v + 3, v + 6, p);
-        if (r <= tol2) in[q] = 1;
-      }
+    const double tol = band(B, v, spacing), tol2 = tol * tol;
+    double lo[3], hi[3];
+    element_box(B, v, d, tol, lo, hi);
+    long c0[3] = {0, 0, 0}, c1[3] = {0, 0, 0}, c[3];
+    for (int a = 0; a < d; ++a) {
+      c0[a] = cell_of(g, a, lo[a], bk->nc[a]);
+      c1[a] = cell_of(g, a, hi[a], bk->nc[a]);
     }
+    for (c[2] = c0[2]; c[2] <= c1[2]; ++c[2])
+      for (c[1] = c0[1]; c[1] <= c1[1]; ++c[1])
+        for (c[0] = c0[0]; c[0] <= c1[0]; ++c[0]) {
+          const long cell = c[0] + bk->nc[0] * (c[1] + bk->nc[1] * c[2]);
+          for (int k = bk->start[cell]; k < bk->start[cell + 1]; ++k) {
+            const int q = bk->pts[k] - first;
+            if (in[q]) continue;
+            double p[3] = {0, 0, 0};
+            for (int a = 0; a < d; ++a) p[a] = x[(size_t)bk->pts[k] * d + a];
+            if (dist2_element(B, v, p) <= tol2) in[q] = 1;
+          }
+        }
   }
-  int n = 0;
-  for (int q = 0; q < count; ++q) n += in[q];
-  int *idx = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
-  if (!idx) {
+  int m = 0;
+  for (int q = 0; q < count; ++q) m += in[q];
+  *idx = malloc(sizeof(int) * (size_t)(m > 0 ? m : 1));
+  if (!*idx) {
     free(in);
     return MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "gmsh: cannot allocate set '%s'", name);
   }
-  n = 0;
+  m = 0;
   for (int q = 0; q < count; ++q)
-    if (in[q]) idx[n++] = first + q;
+    if (in[q]) (*idx)[m++] = first + q;
   free(in);
-  if (n == 0) mpmc_log(sim->ctx, MPMC_LOG_WARNING, "gmsh: no seeded point lies near group '%s'", name);
-  const int err = mpmc_sim_add_particle_set(sim, name, n, idx, NULL);
-  free(idx);
-  return err;
+  if (m == 0) mpmc_log(sim->ctx, MPMC_LOG_WARNING, "gmsh: no seeded point lies near group '%s'", name);
+  *n = m;
+  return MPMC_SUCCESS;
+}
+
+/* The grid nodes of a boundary group: those whose cell of influence (side h, centred on the
+ * node) touches an element, i.e. within band(h) of it; for a point group the node nearest to
+ * each vertex.  Node coordinates ijk in *ijk (malloc'ed, [n][dim]). */
+static int group_nodes(mpmc_sim sim, const simplices *B, const char *name, int **ijk, int *n) {
+  const int d = sim->dim;
+  const mpmc_grid *g = &sim->grid;
+  long nn[3] = {1, 1, 1};
+  size_t total = 1;
+  for (int a = 0; a < d; ++a) {
+    nn[a] = g->n[a] - 2 * MPMC_GHOST; /* nodes 0 .. cells */
+    total *= (size_t)nn[a];
+  }
+  unsigned char *in = calloc(total, 1);
+  MPMC_CHECK(in, sim->ctx, MPMC_ERR_MEMORY, "gmsh: cannot allocate node set '%s'", name);
+  for (size_t e = 0; e < B->n; ++e) {
+    const double *v = B->v + 3 * e * (size_t)B->nv;
+    const double tol = B->nv == 1 ? 0.5 * g->h : band(B, v, g->h), tol2 = tol * tol;
+    double lo[3], hi[3];
+    element_box(B, v, d, tol, lo, hi);
+    long i0[3] = {0, 0, 0}, i1[3] = {0, 0, 0}, i[3];
+    int empty = 0;
+    for (int a = 0; a < d; ++a) {
+      i0[a] = (long)ceil((lo[a] - g->lo[a]) * g->inv_h);
+      i1[a] = (long)floor((hi[a] - g->lo[a]) * g->inv_h);
+      if (i0[a] < 0) i0[a] = 0;
+      if (i1[a] > nn[a] - 1) i1[a] = nn[a] - 1;
+      empty |= i1[a] < i0[a];
+    }
+    if (empty) continue;
+    long best_node = -1;
+    double best = INFINITY;
+    for (i[2] = i0[2]; i[2] <= i1[2]; ++i[2])
+      for (i[1] = i0[1]; i[1] <= i1[1]; ++i[1])
+        for (i[0] = i0[0]; i[0] <= i1[0]; ++i[0]) {
+          double p[3] = {0, 0, 0};
+          for (int a = 0; a < d; ++a) p[a] = g->lo[a] + (double)i[a] * g->h;
+          const long node = i[0] + nn[0] * (i[1] + nn[1] * i[2]);
+          if (B->nv == 1) {
+            double r = 0;
+            for (int a = 0; a < d; ++a) r += (p[a] - v[a]) * (p[a] - v[a]);
+            if (r < best) best = r, best_node = node;
+          } else if (dist2_element(B, v, p) <= tol2) {
+            in[node] = 1;
+          }
+        }
+    if (best_node >= 0) in[best_node] = 1;
+  }
+  int m = 0;
+  for (size_t k = 0; k < total; ++k) m += in[k];
+  *ijk = malloc(sizeof(int) * (size_t)d * (size_t)(m > 0 ? m : 1));
+  if (!*ijk) {
+    free(in);
+    return MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "gmsh: cannot allocate node set '%s'", name);
+  }
+  m = 0;
+  for (size_t k = 0; k < total; ++k)
+    if (in[k]) {
+      size_t r = k;
+      for (int a = 0; a < d; ++a) {
+        (*ijk)[(size_t)m * d + a] = (int)(r % (size_t)nn[a]);
+        r /= (size_t)nn[a];
+      }
+      ++m;
+    }
+  free(in);
+  if (m == 0) mpmc_log(sim->ctx, MPMC_LOG_WARNING, "gmsh: no grid node lies near group '%s'", name);
+  *n = m;
+  return MPMC_SUCCESS;
 }
 
 /* Physical groups of the model: dimension, tag and name. */
@@ -673,9 +812,11 @@ static int list_groups(session *s, pgroup **out, size_t *n) {
  *        order ppc, volume weight * |det J|
  * @param[out] first index of the first new point (may be NULL)
  * @param[out] count number of points added (may be NULL)
- * Every other physical group of lower dimension becomes a particle set named after it:
- * curves (2D) / surfaces (3D) take the new points within half a point spacing, physical
- * points the nearest new point.
+ * Every other physical group of lower dimension becomes a particle set and a node set named
+ * after it: curves (2D) / surfaces (3D) take the new points within half a point spacing and
+ * the grid nodes within half a cell (for a slanted boundary the band is widened to the
+ * tributary square/cube that touches it), physical points the nearest new point and node.
+ * On failure the sim is left as it was (no points, no sets added).
  */
 int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
                    int material, int *first, int *count) {
@@ -731,14 +872,39 @@ int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode,
     for (int q = 0; q < cnt; ++q) v += sim->p.vol0[f0 + q];
     spacing = pow(v / cnt, 1.0 / d);
   }
-  /* boundary and point groups -> particle sets of the new points */
+  /* boundary and point groups -> particle sets of the new points and node sets; all are
+   * computed before any is added, so that a failure leaves the sim as it was */
+  typedef struct {
+    const char *name;
+    int np, nn;
+    int *pidx, *ijk;
+  } groupset;
+  groupset *gs = err ? NULL : calloc(ngroup + 1, sizeof *gs);
+  if (!err && !gs) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "gmsh: cannot allocate %zu sets", ngroup);
+  buckets bk = {0, 0, {1, 1, 1}, NULL, NULL};
+  if (!err) err = buckets_build(sim, f0, cnt, &bk);
   for (size_t i = 0; i < ngroup && !err; ++i) {
     if (groups[i].dim >= d || !groups[i].name || !groups[i].name[0]) continue;
     if (groups[i].dim > 0 && groups[i].dim < d - 1) continue; /* curves in 3D: not a boundary */
     simplices B = {0, 0, 0, NULL};
+    gs[i].name = groups[i].name;
     err = group_simplices(&s, &nd, groups[i].dim, groups[i].tag, groups[i].name, &B);
-    if (!err) err = make_set(sim, &B, groups[i].name, f0, cnt, spacing);
+    if (!err) err = group_points(sim, &B, groups[i].name, &bk, spacing, &gs[i].pidx, &gs[i].np);
+    if (!err) err = group_nodes(sim, &B, groups[i].name, &gs[i].ijk, &gs[i].nn);
     free(B.v);
+  }
+  buckets_free(&bk);
+  for (size_t i = 0; gs && i < ngroup && !err; ++i)
+    if (gs[i].name) {
+      err = mpmc_sim_add_particle_set(sim, gs[i].name, gs[i].np, gs[i].pidx, NULL);
+      if (!err) err = mpmc_sim_add_node_set(sim, gs[i].name, gs[i].nn, gs[i].ijk, NULL);
+    }
+  for (size_t i = 0; gs && i < ngroup; ++i) free(gs[i].pidx), free(gs[i].ijk);
+  free(gs);
+  /* a failure after the points were added takes them back */
+  if (err && cnt > 0 && sim->p.n == f0 + cnt) {
+    sim->p.n = f0;
+    sim->prepared = 0;
   }
   for (size_t i = 0; i < ngroup; ++i) gmshFree(groups[i].name);
   free(groups);

@@ -1,4 +1,5 @@
-/* Named particle sets (sets.c): private structure, shared with checkpoint.c and io_hdf5.c. */
+/* Named particle and node sets (sets.c): private structure, shared with checkpoint.c,
+ * io_hdf5.c and boundary.c. */
 #ifndef MPMC_SETS_H
 #define MPMC_SETS_H
 
@@ -7,7 +8,7 @@
 typedef struct {
   char *name;
   int n;
-  int *idx; /* [n] point indices, as given */
+  int *idx; /* [n] point indices, or [n][dim] node coordinates, as given */
 } mpmc_set;
 
 struct mpmc_sets_s {

@@ -7,6 +7,7 @@
 #endif
 
 #include "mpmc_impl.h"
+#include "sets.h"
 
 /**
  * @brief Create a simulation in dim = 2 (plane strain) or 3 dimensions.
@@ -68,6 +69,8 @@ int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h
   MPMC_CHECK(lo && hi, sim->ctx, MPMC_ERR_ARG, "grid lo/hi arrays are NULL");
   MPMC_CHECK(sim->p.n == 0, sim->ctx, MPMC_ERR_STATE,
              "the grid must be set before material points are added");
+  MPMC_CHECK(!sim->node_sets || sim->node_sets->n == 0, sim->ctx, MPMC_ERR_STATE,
+             "the grid must be set before node sets are added");
   MPMC_CALL(mpmc_grid_setup(sim->ctx, &sim->grid, sim->dim, lo, hi, h));
   sim->prepared = 0;
   sim->walls_dirty = 1;
