@@ -1033,8 +1033,10 @@ contains
 
   !> Run one stage of an analysis: step until `duration` [s] of simulated time has passed,
   !> or -- when ke_ratio > 0 (a quasi-static stage) -- until the kinetic energy has fallen to
-  !> ke_ratio of its largest value in this stage after at least min_time [s] (duration is
-  !> then the maximum time; the energy is checked on steps 1, 11, 21, ... and at the end).
+  !> ke_ratio of its largest value in this stage after at least min_time [s] and stayed there
+  !> at every check for 5 % of the stage time so far (at least 50 steps), so that the turning
+  !> point of a slow swing does not end the stage (duration is then the maximum time; the
+  !> energy is checked on steps 1, 11, 21, ... and at the end).
   !> The step is dt [s] when given and > 0, else mpmc_sim_stable_dt(dt_factor) (default 0.3)
   !> refreshed every 10 steps; the last step is shortened to end on `duration`.  This is the
   !> stage loop of the `mpmc` front end (workflows/run.c, run_stage), so a program that builds
@@ -1050,7 +1052,7 @@ contains
     integer, intent(out), optional :: nsteps
     logical, intent(out), optional :: quasi_static
     integer(c_int) :: ierr
-    real(c_double) :: factor, dt_fixed, ratio_end, t_min, t, step_dt, h, ke, ke_max, ratio
+    real(c_double) :: factor, dt_fixed, ratio_end, t_min, t, step_dt, h, ke, ke_max, ratio, below
     integer :: n
     logical :: qs, at_end
     factor = 0.3_c_double
@@ -1069,6 +1071,7 @@ contains
     t = 0
     n = 0
     ke_max = 0
+    below = -1
     qs = .false.
     at_end = .false.
     do while (.not. (qs .or. at_end))
@@ -1090,7 +1093,12 @@ contains
         ke_max = max(ke_max, ke)
         ratio = 0
         if (ke_max > 0) ratio = ke/ke_max
-        qs = ratio <= ratio_end .and. t >= t_min .and. n > 1
+        if (ratio <= ratio_end .and. t >= t_min) then
+          if (below < 0) below = t
+          qs = t - below >= max(0.05_c_double*t, 50*h)
+        else
+          below = -1
+        end if
       end if
     end do
     if (present(quasi_static)) quasi_static = qs

@@ -48,6 +48,8 @@ typedef struct {
   int noverride;
   const char *const *overrides;
   double strength;         /* the strength reduction factor in force (1: as given)        */
+  double ke_below;         /* stage time since which E_k/E_k,max has stayed below the
+                              quasi-static ratio (-1: it is above); saved in checkpoints   */
   int saved_threads;       /* OpenMP threads before the run (0: unchanged)                 */
   int ckpt_ok;             /* a checkpoint (the last good state) has been written           */
   double ckpt_time;        /* its simulated time                                          */
@@ -383,8 +385,8 @@ static int checkpoint(wf_run *w, int stage, double t_stage, long steps, double k
   /* the absolute path, so that `mpmc resume` works from any directory */
   if (!realpath(w->sc.path, scene)) snprintf(scene, sizeof scene, "%s", w->sc.path);
   size_t l = (size_t)snprintf(meta, sizeof meta, "mpmc-workflow 1\nscene %s\nstage %d\nsetup %d\nstage_time %.17g\n"
-                              "stage_steps %ld\nke_max %.17g\nstrength %.17g\n", scene, stage, setup_done, t_stage, steps,
-                              ke_max, w->strength);
+                              "stage_steps %ld\nke_max %.17g\nke_below %.17g\nstrength %.17g\n", scene, stage, setup_done,
+                              t_stage, steps, ke_max, setup_done ? w->ke_below : -1.0, w->strength);
   for (int i = 0; i < w->noverride && l < sizeof meta; ++i)
     l += (size_t)snprintf(meta + l, sizeof meta - l, "set %s\n", w->overrides[i]);
   for (int i = 0; i < w->nwall_ids && l < sizeof meta; ++i)
@@ -422,6 +424,24 @@ static int step_failed(wf_run *w, int e, const wf_stage *s, double t, long steps
 }
 
 /* Run stage i from t_stage (0 unless resuming). */
+/* The quasi-static end test, checked every 10 steps: E_k/E_k,max <= tol must hold at every
+ * check for a while, not just once.  A slow oscillation (Cook's membrane under its dead load
+ * swings with a period of ~60 s) passes through E_k = 0 at each turning point: a single
+ * check there ended the stage at the peak of the swing, 1.6 % beyond the equilibrium.  The
+ * ratio stays below tol near a turning point for about 2 sqrt(tol) / omega, a fraction
+ * sqrt(tol) / pi of the period, so holding it for 5 % of the stage time so far (at least 50
+ * steps) rejects the turning points of any swing whose energy is still above ~5 tol.
+ * *below: stage time since the ratio has stayed below tol, -1 when above. */
+static int wf_quasi_static(double ratio, double tol, double t_stage, double min_time, double dt,
+                           double *below) {
+  if (!(ratio <= tol) || t_stage < min_time) {
+    *below = -1.0;
+    return 0;
+  }
+  if (*below < 0) *below = t_stage;
+  return t_stage - *below >= fmax(0.05 * t_stage, 50.0 * dt);
+}
+
 static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_max, wf_progress *pr) {
   long steps = *nsteps;
   const wf_scene *sc = &w->sc;
@@ -466,12 +486,13 @@ static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_m
       return fail(w, MPMC_ERR_IO, "%s", spmsg);
     const int at_end = t_stage >= T * (1 - 1e-9); /* not a sliver of a step for round-off */
     if (s->end_kind == WF_END_QUASI_STATIC) {
-      /* quasi-static when the kinetic energy has fallen to ke_ratio of its stage maximum */
+      /* quasi-static when the kinetic energy has fallen to ke_ratio of its stage maximum and
+       * stayed there (wf_quasi_static) */
       if ((steps - s0) % 10 == 1 || at_end) { /* an O(n) reduction: not every step */
         mpmc_sim_get_kinetic_energy(sim, &ke);
         if (ke > ke_max) ke_max = ke;
         ratio = ke_max > 0 ? ke / ke_max : 0.0;
-        if (ratio <= s->ke_ratio && t_stage >= s->min_time && steps - s0 > 1) reason = "quasi_static";
+        if (wf_quasi_static(ratio, s->ke_ratio, t_stage, s->min_time, h, &w->ke_below)) reason = "quasi_static";
       }
     }
     if (!reason && at_end) reason = s->end_kind == WF_END_TIME ? "time" : "max_time";
@@ -604,6 +625,7 @@ static int run_all(wf_run *w, int first_stage, double t_stage, long steps, doubl
   for (int i = first_stage; i < w->sc.nstage; ++i) {
     if (!(i == first_stage && setup_done) && stage_setup(w, i)) return -1;
     if (i == first_stage && t_stage == 0 && series_row(w, i, steps, 0, 0, 1)) return -1;
+    if (!(i == first_stage && t_stage > 0)) w->ke_below = -1.0; /* else restored from the checkpoint */
     if (run_stage(w, i, i == first_stage ? t_stage : 0, &steps, i == first_stage ? ke_max : 0, &pr)) return -1;
 #ifdef MPMC_WF_HAVE_CHECKPOINT
     if (i + 1 < w->sc.nstage && checkpoint(w, i + 1, 0, steps, 0, 0)) return -1;
@@ -730,7 +752,7 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
   /* parse the workflow's record */
   char scene[WF_PATH] = "";
   int stage = -1, setup = 0, nset = 0, nwall = 0, ndone = 0;
-  double t_stage = 0, ke_max = 0, strength = 1;
+  double t_stage = 0, ke_max = 0, strength = 1, ke_below = -1;
   long steps = 0;
   char **sets = calloc(1, sizeof *sets);
   int *walls = NULL;
@@ -742,7 +764,8 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
       snprintf(scene, sizeof scene, "%s", line + 6);
     else if (sscanf(line, "stage %d", &stage) == 1 || sscanf(line, "setup %d", &setup) == 1 ||
              sscanf(line, "stage_time %lf", &t_stage) == 1 || sscanf(line, "stage_steps %ld", &steps) == 1 ||
-             sscanf(line, "ke_max %lf", &ke_max) == 1 || sscanf(line, "strength %lf", &strength) == 1)
+             sscanf(line, "ke_max %lf", &ke_max) == 1 || sscanf(line, "strength %lf", &strength) == 1 ||
+             sscanf(line, "ke_below %lf", &ke_below) == 1)
       continue;
     else if (!strncmp(line, "set ", 4)) {
       char **s2 = realloc(sets, sizeof *sets * (size_t)(nset + 1));
@@ -790,6 +813,7 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
     w.ckpt_ok = 1; /* the checkpoint resumed from is the last good state until the next one */
     mpmc_sim_get_time(w.sim, &w.ckpt_time);
     w.strength = strength;
+    w.ke_below = ke_below;
     set_threads(&w);
     mpmc_sim_set_threads(w.sim, w.sc.threads);
     sim = NULL;
