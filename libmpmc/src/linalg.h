@@ -34,15 +34,16 @@ static inline void mpmc_embed(int dim, const double *f, double F[3][3]) {
     for (int j = 0; j < 3; ++j) F[i][j] = (i < dim && j < dim) ? f[i * dim + j] : (i == j);
 }
 
-/* b <- F b F^T for symmetric b (Voigt). */
+/* b <- F b F^T for symmetric b (Voigt): T = F b, then only the upper triangle of T F^T,
+ * which is symmetric by construction (45 multiplications instead of 54). */
 static inline void mpmc_push_forward(double F[3][3], double *b) {
-  double B[3][3], T[3][3], R[3][3];
+  double B[3][3], T[3][3];
   mpmc_voigt_to_mat(b, B);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) T[i][j] = F[i][0] * B[0][j] + F[i][1] * B[1][j] + F[i][2] * B[2][j];
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) R[i][j] = T[i][0] * F[j][0] + T[i][1] * F[j][1] + T[i][2] * F[j][2];
-  mpmc_mat_to_voigt(R, b);
+    for (int j = i; j < 3; ++j)
+      b[mpmc_voigt(i, j)] = T[i][0] * F[j][0] + T[i][1] * F[j][1] + T[i][2] * F[j][2];
 }
 
 static inline double mpmc_det3(double A[3][3]) {
@@ -102,6 +103,129 @@ static inline void mpmc_sym3_compose(const double d[3], double Q[3][3], double *
       const double v = d[0] * Q[i][0] * Q[j][0] + d[1] * Q[i][1] * Q[j][1] + d[2] * Q[i][2] * Q[j][2];
       s[mpmc_voigt(i, j)] = v;
     }
+}
+
+/* c = a b for symmetric a, b that commute (functions of one tensor), so that a b is
+ * symmetric: only its upper triangle is formed (Voigt). */
+static inline void mpmc_sym3_mul(const double *a, const double *b, double *c) {
+  const double xx = a[0] * b[0] + a[5] * b[5] + a[4] * b[4];
+  const double yy = a[5] * b[5] + a[1] * b[1] + a[3] * b[3];
+  const double zz = a[4] * b[4] + a[3] * b[3] + a[2] * b[2];
+  const double yz = a[5] * b[4] + a[1] * b[3] + a[3] * b[2];
+  const double xz = a[0] * b[4] + a[5] * b[3] + a[4] * b[2];
+  const double xy = a[0] * b[5] + a[5] * b[1] + a[4] * b[3];
+  c[0] = xx;
+  c[1] = yy;
+  c[2] = zz;
+  c[3] = yz;
+  c[4] = xz;
+  c[5] = xy;
+}
+
+/* |s|^2 = s : s (Voigt, tensor shear components) */
+static inline double mpmc_sym3_norm2(const double *s) {
+  return s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
+}
+
+/* Hencky strain eps = 1/2 ln b of a symmetric b (Voigt) near the identity, without an
+ * eigen-decomposition (issue 6: the geotechnical norm is |eps| ~ 1e-3, where the Jacobi
+ * sweeps and three logs made an elastic J2 point ~6x dearer, bench_return_map):
+ *   eps = atanh(Z) = Z sum_k Z^(2k) / (2k+1),  Z = (b - I)(b + I)^-1,
+ * Z a function of b, so every product commutes.  An eigenvalue z of Z leaves the truncated
+ * series a relative error below rho^(2N) / ((2N+1)(1 - rho^2)), rho = |Z|_F >= |z|; N is
+ * the least number of terms that makes this <= 2^-54 (the table holds the largest rho^2
+ * for each N).  The error is relative per principal strain, where the eigen path's
+ * 1/2 ln(lambda) carries an absolute error of ~1e-16 (round-off of lambda ~ 1).
+ * Returns 0, or 1 when |Z|_F > 0.179 (|eps| >~ 0.18: use the eigen path) or b is not
+ * finite; a b with eigenvalues <= 0 gives |z| >= 1 or a singular b + I, so also 1. */
+static inline int mpmc_sym3_log_series(const double *b, double *eps) {
+  static const double rho2_max[11] = {0.0,       1.665e-16, 1.666e-08, 7.297e-06,
+                                      1.4949e-04, 9.0589e-04, 2.9934e-03, 7.0039e-03,
+                                      1.3216e-02, 2.1619e-02, 3.2007e-02};
+  static const double c[10] = {1.0,       1.0 / 3.0,  1.0 / 5.0,  1.0 / 7.0,  1.0 / 9.0,
+                               1.0 / 11.0, 1.0 / 13.0, 1.0 / 15.0, 1.0 / 17.0, 1.0 / 19.0};
+  const double a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
+  const double m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
+  const double adj[6] = {m[1] * m[2] - m[3] * m[3], m[0] * m[2] - m[4] * m[4],
+                         m[0] * m[1] - m[5] * m[5], m[4] * m[5] - m[0] * m[3],
+                         m[5] * m[3] - m[1] * m[4], m[4] * m[3] - m[2] * m[5]};
+  const double det = m[0] * adj[0] + m[5] * adj[5] + m[4] * adj[4];
+  double z[6], w[6], p[6];
+  mpmc_sym3_mul(a, adj, z);
+  const double inv_det = 1.0 / det;
+  for (int k = 0; k < 6; ++k) z[k] *= inv_det;
+  const double r2 = mpmc_sym3_norm2(z);
+  if (!(r2 <= rho2_max[10])) return 1; /* also NaN, Inf */
+  int n = 1;
+  while (r2 > rho2_max[n]) ++n;
+  if (n == 1) {
+    for (int k = 0; k < 6; ++k) eps[k] = z[k];
+    return 0;
+  }
+  mpmc_sym3_mul(z, z, w);
+  /* Horner in W = Z^2: p = c_{n-1} W + c_{n-2} I, then p <- W p + c_k I */
+  for (int k = 0; k < 6; ++k) p[k] = c[n - 1] * w[k];
+  for (int k = 0; k < 3; ++k) p[k] += c[n - 2];
+  for (int j = n - 3; j >= 0; --j) {
+    mpmc_sym3_mul(w, p, p);
+    for (int k = 0; k < 3; ++k) p[k] += c[j];
+  }
+  mpmc_sym3_mul(z, p, eps);
+  return 0;
+}
+
+/* eps = 1/2 ln b by the eigen-decomposition, for any b: the reference and the fallback of
+ * mpmc_sym3_log_series.  A b that is not positive definite gives NaN (the callers' guards
+ * report it). */
+static inline void mpmc_sym3_log_eig(const double *b, double *eps) {
+  double lam[3], Q[3][3];
+  mpmc_sym3_eig(b, lam, Q);
+  for (int a = 0; a < 3; ++a) lam[a] = 0.5 * log(lam[a]);
+  mpmc_sym3_compose(lam, Q, eps);
+}
+
+/* E = exp(M) of a symmetric M (Voigt) of small norm by its Taylor series in Horner form
+ * (the returned b_e = exp(2 eps) of a plastic point on the fast path).  With rho = |M|_F the
+ * tail after M^n / n! is below rho^(n+1) / (n+1)! e^rho, and E's smallest eigenvalue is
+ * >= e^-rho, so the relative error is below rho^(n+1) / (n+1)! e^(2 rho); n is the least
+ * that makes this <= 2^-54 (the table holds the largest rho^2 for each n).
+ * Returns 0, or 1 when |M|_F > 0.728 or M is not finite. */
+static inline int mpmc_sym3_exp_series(const double *M, double *E) {
+  static const double rho2_max[17] = {
+      0.0,        1.110e-16,  4.804e-11,  3.649e-08,  2.1326e-06, 3.4057e-05,
+      2.5668e-04, 1.2021e-03, 4.0814e-03, 1.1030e-02, 2.5199e-02, 5.0682e-02,
+      9.2330e-02, 1.5550e-01, 2.4586e-01, 3.6911e-01, 5.3089e-01};
+  static const double c[17] = {1.0,
+                               1.0,
+                               1.0 / 2.0,
+                               1.0 / 6.0,
+                               1.0 / 24.0,
+                               1.0 / 120.0,
+                               1.0 / 720.0,
+                               1.0 / 5040.0,
+                               1.0 / 40320.0,
+                               1.0 / 362880.0,
+                               1.0 / 3628800.0,
+                               1.0 / 39916800.0,
+                               1.0 / 479001600.0,
+                               1.0 / 6227020800.0,
+                               1.0 / 87178291200.0,
+                               1.0 / 1307674368000.0,
+                               1.0 / 20922789888000.0};
+  const double r2 = mpmc_sym3_norm2(M);
+  if (!(r2 <= rho2_max[16])) return 1;
+  int n = 1;
+  while (r2 > rho2_max[n]) ++n;
+  double p[6];
+  /* p = c_n M + c_{n-1} I, then p <- M p + c_k I down to k = 0 */
+  for (int k = 0; k < 6; ++k) p[k] = c[n] * M[k];
+  for (int k = 0; k < 3; ++k) p[k] += c[n - 1];
+  for (int j = n - 2; j >= 0; --j) {
+    mpmc_sym3_mul(M, p, p);
+    for (int k = 0; k < 3; ++k) p[k] += c[j];
+  }
+  for (int k = 0; k < 6; ++k) E[k] = p[k];
+  return 0;
 }
 
 #endif

@@ -1,5 +1,6 @@
 /* Hencky elasticity: principal logarithmic strains eps_a = 1/2 ln(lambda_a^2) of b = Fbar
- * Fbar^T, tau_a = K tr(eps) + 2G dev(eps)_a, coaxial with b. */
+ * Fbar^T, tau_a = K tr(eps) + 2G dev(eps)_a, coaxial with b.  Small strains (|eps| <~ 0.18)
+ * take the eigen-free series of linalg.h; both paths agree to round-off (tests/t411). */
 #include <math.h>
 
 #include "linalg.h"
@@ -13,16 +14,20 @@ static int hencky_update(mpmc_sim sim, const mpmc_material *mat, int id, double 
 #pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
     if (p->mat[q] != id) continue;
-    double F[3][3], lam[3], Q[3][3], eps[3], tau[3];
-    mpmc_embed(d, p->dF + (size_t)q * d * d, F);
-    double *b = p->be + (size_t)q * 6;
+    double F3[3][3];
+    /* 3D: dF is already a row-major 3x3 */
+    double(*F)[3] = d == 3 ? (double(*)[3])(p->dF + (size_t)q * 9) : F3;
+    if (d != 3) mpmc_embed(d, p->dF + (size_t)q * d * d, F3);
+    double *b = p->be + (size_t)q * 6, *sg = p->stress + (size_t)q * 6;
     mpmc_push_forward(F, b);
-    mpmc_sym3_eig(b, lam, Q);
-    for (int a = 0; a < 3; ++a) eps[a] = 0.5 * log(lam[a]);
+    double eps[6];
+    /* eps = 1/2 ln b: series for small strains, eigen path beyond (linalg.h) */
+    if (mpmc_sym3_log_series(b, eps)) mpmc_sym3_log_eig(b, eps);
     const double tr = eps[0] + eps[1] + eps[2];
-    const double inv_J = exp(-tr);
-    for (int a = 0; a < 3; ++a) tau[a] = (K * tr + G2 * (eps[a] - tr / 3.0)) * inv_J;
-    mpmc_sym3_compose(tau, Q, p->stress + (size_t)q * 6);
+    const double inv_J = exp(-tr), p0 = (K - G2 / 3.0) * tr;
+    /* sigma = (K tr eps I + 2G dev eps) / J */
+    for (int k = 0; k < 6; ++k) sg[k] = G2 * eps[k] * inv_J;
+    for (int k = 0; k < 3; ++k) sg[k] += p0 * inv_J;
   }
   return MPMC_SUCCESS;
 }

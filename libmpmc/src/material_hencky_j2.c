@@ -18,17 +18,12 @@
 #include "linalg.h"
 #include "return_map.h"
 
-/**
- * @brief Return map of one point (return_map.h); private, used by the tests and bench/.
- */
-int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],
-                       double *be, double *eps_p, double *tau, double *J_out,
-                       mpmc_j2_info *info) {
-  mpmc_j2_info local = {0};
-  if (!info) info = &local;
-  double b[6], lam[3], Q[3][3], eps[3], e[3], s[3];
-  for (int k = 0; k < 6; ++k) b[k] = be[k];
-  if (F) mpmc_push_forward(F, b);
+/* The eigen path: principal logarithmic strains of any positive definite trial b (the
+ * fast path's fallback for |eps| >~ 0.18). */
+static int return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, const double *b,
+                          double *be, double *eps_p, double *tau, double *J_out,
+                          mpmc_j2_info *info) {
+  double lam[3], Q[3][3], eps[3], e[3], s[3];
   mpmc_sym3_eig(b, lam, Q);
   for (int a = 0; a < 3; ++a)
     if (!(lam[a] > 0.0) || !isfinite(lam[a])) return MPMC_ERR_NUMERIC;
@@ -70,6 +65,83 @@ int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, doubl
   return MPMC_SUCCESS;
 }
 
+/**
+ * @brief The return map of one point by the eigen path alone (return_map.h): the reference
+ * the tests compare the fast path with.
+ */
+int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],
+                           double *be, double *eps_p, double *tau, double *J_out,
+                           mpmc_j2_info *info) {
+  mpmc_j2_info local = {0};
+  if (!info) info = &local;
+  double b[6];
+  for (int k = 0; k < 6; ++k) b[k] = be[k];
+  if (F) mpmc_push_forward(F, b);
+  return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
+}
+
+/* The return in tensor form, without an eigen-decomposition, whenever the trial Hencky
+ * strain eps = 1/2 ln b is small enough for the series of linalg.h (|eps| <~ 0.18):
+ * tau = K tr(eps) I + 2G dev(eps) is coaxial with eps by construction, the radial return
+ * scales dev(eps), and only a plastic point needs b_e = exp(2 tr/3) exp(2 dev eps_new).
+ * Both paths agree to round-off (tests/t411).  Inlined into the point loop below. */
+static inline int return_map_point(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m,
+                                   double F[3][3], double *be, double *eps_p, double *tau,
+                                   double *J_out, mpmc_j2_info *info) {
+  double b[6], eps[6];
+  for (int k = 0; k < 6; ++k) b[k] = be[k];
+  if (F) mpmc_push_forward(F, b);
+  if (mpmc_sym3_log_series(b, eps))
+    return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
+  const double tr = eps[0] + eps[1] + eps[2], G2 = 2.0 * m->G;
+  double e[6];
+  for (int k = 0; k < 6; ++k) e[k] = eps[k];
+  for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
+  const double qtr = sqrt(1.5 * mpmc_sym3_norm2(e)) * G2;
+  double J;
+  const double k0 = mpmc_j2_kappa(m, *eps_p);
+  info->q_trial = qtr;
+  info->kappa = k0;
+  info->plastic = 0;
+  info->dgamma = 0.0;
+  if (!isfinite(qtr)) return MPMC_ERR_NUMERIC;
+  if (qtr > k0) {
+    double dg, qn, en[6], bn[6];
+    info->plastic = 1;
+    MPMC_CALL(mpmc_rm_solve_k(ws, solver, m, qtr, *eps_p, k0, &dg, &qn, info));
+    const double f = qn / qtr; /* radial return: = 1 - 3G dgamma / q_trial */
+    for (int k = 0; k < 6; ++k) {
+      e[k] *= f;
+      en[k] = 2.0 * e[k];
+    }
+    if (mpmc_sym3_exp_series(en, bn)) { /* not reached for |eps| < 0.18; stay safe */
+      *info = (mpmc_j2_info){0};
+      return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
+    }
+    const double v = exp(tr / 3.0), vol = v * v; /* one exp for exp(2 tr/3) and J */
+    for (int k = 0; k < 6; ++k) be[k] = vol * bn[k];
+    *eps_p += dg;
+    J = vol * v;
+  } else {
+    for (int k = 0; k < 6; ++k) be[k] = b[k]; /* elastic: keep b_e as pushed forward */
+    J = exp(tr);
+  }
+  for (int k = 0; k < 6; ++k) tau[k] = G2 * e[k];
+  for (int k = 0; k < 3; ++k) tau[k] += m->K * tr;
+  if (J_out) *J_out = J;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Return map of one point (return_map.h); private, used by the tests and bench/.
+ */
+int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],
+                       double *be, double *eps_p, double *tau, double *J_out,
+                       mpmc_j2_info *info) {
+  mpmc_j2_info local = {0};
+  return return_map_point(ws, solver, m, F, be, eps_p, tau, J_out, info ? info : &local);
+}
+
 static const char *solver_name(int solver) {
   return solver == MPMC_SOLVER_NEWTON ? "newton" : solver == MPMC_SOLVER_KINSOL ? "kinsol" : "auto";
 }
@@ -99,11 +171,13 @@ static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) 
 #pragma omp for schedule(static)
     for (int q = 0; q < p->n; ++q) {
       if (p->mat[q] != id) continue;
-      double F[3][3], tau[6], J;
+      double F3[3][3], tau[6], J;
       mpmc_j2_info info = {0};
-      mpmc_embed(d, p->dF + (size_t)q * d * d, F);
-      const int err = mpmc_j2_return_map(w, solver, &par, F, p->be + (size_t)q * 6, p->eps_p + q,
-                                         tau, &J, &info);
+      /* 3D: dF is already a row-major 3x3 */
+      double(*F)[3] = d == 3 ? (double(*)[3])(p->dF + (size_t)q * 9) : F3;
+      if (d != 3) mpmc_embed(d, p->dF + (size_t)q * d * d, F3);
+      const int err = return_map_point(w, solver, &par, F, p->be + (size_t)q * 6, p->eps_p + q,
+                                       tau, &J, &info);
       if (err) {
         if (q < first_bad) first_bad = q;
         continue;

@@ -44,7 +44,9 @@ typedef struct {
 } rm_pool;
 
 double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p) {
-  return m->kappa_r + (m->kappa_p - m->kappa_r) * exp(-m->eta * eps_p);
+  /* exp(-0) = 1 exactly: points that never yielded (most of a slope) skip the exp */
+  const double x = m->eta * eps_p;
+  return m->kappa_r + (m->kappa_p - m->kappa_r) * (x == 0.0 ? 1.0 : exp(-x));
 }
 
 /* The unknown is the returned von Mises stress y = q_trial - 3G dgamma, in [kappa_r,
@@ -59,8 +61,11 @@ static inline double rm_r(const mpmc_j2_param *m, double qtr, double ep0, double
 }
 
 /* Converged when |r| is below 1e-12 of the residual strength (or round-off of kappa). */
+static inline double rm_tol(const mpmc_j2_param *m, double kappa0) {
+  return 1e-12 * m->kappa_r + 16.0 * DBL_EPSILON * kappa0;
+}
 double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p) {
-  return 1e-12 * m->kappa_r + 16.0 * DBL_EPSILON * mpmc_j2_kappa(m, eps_p);
+  return rm_tol(m, mpmc_j2_kappa(m, eps_p));
 }
 
 /* ---- KINSOL ------------------------------------------------------------------------- */
@@ -190,13 +195,15 @@ static int solve_kinsol(mpmc_rm_ws *ws, const mpmc_j2_param *m, double qtr, doub
  * y = kappa(eps_p)).  strict = 1 (auto): return 1 ("stiff") instead of safeguarding;
  * strict = 0 (newton): bisect whenever the Newton step leaves the bracket. */
 static int solve_newton(const mpmc_j2_param *m, double qtr, double ep0, double tol, int strict,
-                        double *lo, double *hi, double *y, mpmc_j2_info *info) {
+                        double *lo, double *hi, double *y, double *res, mpmc_j2_info *info) {
   double yi = *hi, rprev = INFINITY;
+  *res = NAN; /* |r(y)| when the returned y is an evaluated iterate, else NaN */
   for (int it = 0; it < RM_MAX_ITERS; ++it) {
     double dr;
     const double r = rm_r(m, qtr, ep0, yi, &dr);
     if (fabs(r) <= tol) {
       *y = yi;
+      *res = fabs(r);
       return 0;
     }
     if (r < 0)
@@ -231,25 +238,34 @@ static int solve_newton(const mpmc_j2_param *m, double qtr, double ep0, double t
  */
 int mpmc_rm_solve(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double qtr, double ep0,
                   double *dgamma, double *q_new, mpmc_j2_info *info) {
+  return mpmc_rm_solve_k(ws, solver, m, qtr, ep0, mpmc_j2_kappa(m, ep0), dgamma, q_new, info);
+}
+
+/**
+ * @brief mpmc_rm_solve with kappa(eps_p) given (the return map has it already).
+ */
+int mpmc_rm_solve_k(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double qtr, double ep0,
+                    double k0, double *dgamma, double *q_new, mpmc_j2_info *info) {
   mpmc_j2_info local = {0};
   if (!info) info = &local;
-  const double k0 = mpmc_j2_kappa(m, ep0);
   info->q_trial = qtr;
   info->kappa = k0;
   if (!(isfinite(qtr) && isfinite(k0) && isfinite(m->G) && m->G > 0)) return MPMC_ERR_NUMERIC;
   if (!(qtr > k0)) return MPMC_ERR_ARG; /* elastic: nothing to solve */
-  const double tol = mpmc_rm_tolerance(m, ep0);
+  const double tol = rm_tol(m, k0);
   /* bracket of y (return_map.h): r(kappa_r) <= 0 <= r(kappa(eps_p)) */
   double lo = m->kappa_r, hi = k0;
   if (hi < lo) hi = lo;
-  double y = hi;
+  double y = hi, res = NAN;
   int err = MPMC_SUCCESS;
   if (solver == MPMC_SOLVER_KINSOL) {
     err = solve_kinsol(ws, m, qtr, ep0, lo, tol, &y, info);
   } else {
-    const int stiff = solve_newton(m, qtr, ep0, tol, solver == MPMC_SOLVER_AUTO, &lo, &hi, &y, info);
+    const int stiff =
+        solve_newton(m, qtr, ep0, tol, solver == MPMC_SOLVER_AUTO, &lo, &hi, &y, &res, info);
     if (stiff) {
       info->fallback = 1;
+      res = NAN;
       /* from the bracket's lower end KINSOL's Newton steps increase monotonically to the root */
       err = solve_kinsol(ws, m, qtr, ep0, lo, tol, &y, info);
     }
@@ -257,7 +273,7 @@ int mpmc_rm_solve(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double qtr
   if (err) return err;
   const double dg = (qtr - y) / (3.0 * m->G);
   info->dgamma = dg;
-  info->residual = fabs(rm_r(m, qtr, ep0, y, NULL));
+  info->residual = isnan(res) ? fabs(rm_r(m, qtr, ep0, y, NULL)) : res;
   if (!(dg >= 0.0) || !isfinite(dg) || !(y > 0.0) || !(info->residual <= tol))
     return MPMC_ERR_SOLVER;
   *dgamma = dg;

@@ -53,6 +53,10 @@ double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p);
 double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p);
 int mpmc_rm_solve(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q_trial,
                   double eps_p, double *dgamma, double *q_new, mpmc_j2_info *info);
+/* the same with kappa0 = mpmc_j2_kappa(m, eps_p) already known (saves its exp) */
+int mpmc_rm_solve_k(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q_trial,
+                    double eps_p, double kappa0, double *dgamma, double *q_new,
+                    mpmc_j2_info *info);
 
 /* The whole return map of one point (material_hencky_j2.c):
  *   F    relative deformation gradient (3x3, F-bar scaled when on); NULL: be is already
@@ -66,6 +70,12 @@ int mpmc_rm_solve(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q_t
 int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],
                        double *be, double *eps_p, double *tau, double *J_out,
                        mpmc_j2_info *info);
+
+/* The same by the eigen-decomposition of the trial b_e for every point (mpmc_j2_return_map
+ * takes the eigen-free series of linalg.h when |ln b_e| <~ 0.36): the reference of tests/t411. */
+int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],
+                           double *be, double *eps_p, double *tau, double *J_out,
+                           mpmc_j2_info *info);
 
 /* The per-thread workspaces of a simulation (sim->solver_ws): makes sure there are
  * at least nthreads and returns them; freed by mpmc_return_map_free. */
