@@ -2,8 +2,14 @@
  *   block  - a 3D elastic (Hencky) block, quadratic B-splines, F-bar off / on
  *   column - the 3D column collapse of issue 6: 2 x 0.5 x 1 m domain, h = 0.025 m, a 0.5 m
  *            cube of J2 soil with 2x2x2 points per cell (64,000 points), gravity
- * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale]; scale multiplies the number
- * of cells per axis of the column (1 = 64,000 points). */
+ * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale] [case] [threads] [shuffle];
+ * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-4,
+ * the rows of the table; -1 all) and threads (1 or 2; 0 both) narrow the run for profiling,
+ * e.g. under callgrind; shuffle = 1 stores the points in random order (what sorting the
+ * particle arrays by cell would undo: the cost of lost locality).  With MPMC_BENCH_CPU set in
+ * the environment the rates are per second of the process's CPU time (all threads) instead
+ * of wall-clock time: on a shared, loaded machine that is the steadier measure of the code's
+ * cost. */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -32,10 +38,11 @@ static double bytes_per_point(const mpmc_sim sim) {
   return b;
 }
 static double last_bytes;
+static int shuffle_points, use_cpu_time;
 
 static double now(void) {
   struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
+  clock_gettime(use_cpu_time ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
@@ -75,6 +82,19 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
   else
     CHECK(mpmc_sim_add_material_hencky(sim, 10e6, 0.3, 2000, &mat));
   CHECK(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, np));
+  if (shuffle_points) { /* every other field is still uniform: permuting x and x0 suffices */
+    mpmc_particles *p = &sim->p;
+    srand(12345);
+    for (int q = *np - 1; q > 0; --q) {
+      const int r = (int)(((double)rand() / ((double)RAND_MAX + 1.0)) * (q + 1));
+      for (int a = 0; a < 3; ++a) {
+        double t = p->x[3 * q + a];
+        p->x[3 * q + a] = p->x[3 * r + a], p->x[3 * r + a] = t;
+        t = p->x0[3 * q + a];
+        p->x0[3 * q + a] = p->x0[3 * r + a], p->x0[3 * r + a] = t;
+      }
+    }
+  }
   if (scene == 1) {
     const double g[3] = {0, 0, -9.81};
     CHECK(mpmc_sim_set_gravity(sim, g));
@@ -99,6 +119,10 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
 int main(int argc, char **argv) {
   const int steps = argc > 1 ? atoi(argv[1]) : 20;
   const double scale = argc > 2 ? atof(argv[2]) : 1.0;
+  const int only = argc > 3 ? atoi(argv[3]) : -1;
+  const int nthr = argc > 4 ? atoi(argv[4]) : 0;
+  shuffle_points = argc > 5 ? atoi(argv[5]) : 0;
+  use_cpu_time = getenv("MPMC_BENCH_CPU") != NULL;
   const char *bn[4] = {"linear", "ugimp", "bspline2", "bspline3"};
   const char *fb[3] = {"off", "paper", "total"};
   struct {
@@ -111,9 +135,15 @@ int main(int argc, char **argv) {
   printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s %7s\n", "scene", "basis", "fbar", "material",
          "points", "1 thread [M/s]", "2 threads [M/s]", "speedup", "B/point");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
-    int np;
-    const double r1 = run(cases[c].scene, cases[c].basis, cases[c].fbar, cases[c].j2, 1, steps, scale, &np);
-    const double r2 = run(cases[c].scene, cases[c].basis, cases[c].fbar, cases[c].j2, 2, steps, scale, &np);
+    if (only >= 0 && (size_t)only != c) continue;
+    int np = 0;
+    double r1 = NAN, r2 = NAN;
+    for (int t = 1; t <= 2; ++t) {
+      if (nthr && nthr != t) continue;
+      const double r = run(cases[c].scene, cases[c].basis, cases[c].fbar, cases[c].j2, t, steps,
+                           scale, &np);
+      *(t == 1 ? &r1 : &r2) = r;
+    }
     printf("%-7s %-9s %-5s %-10s %9d %14.3f %14.3f %8.2f %7.0f\n", cases[c].scene ? "column" : "block",
            bn[cases[c].basis], fb[cases[c].fbar], cases[c].j2 ? "hencky_j2" : "hencky", np, r1 / 1e6,
            r2 / 1e6, r2 / r1, last_bytes);

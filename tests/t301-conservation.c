@@ -57,7 +57,7 @@ static void run(int dim, int basis, double blend, int fbar, int nsteps) {
   for (int s = 0; s < nsteps; ++s) TCALL(mpmc_sim_step(sim, dt));
   /* the grid mass of the last P2G equals the total mass */
   double gm = 0.0;
-  for (size_t i = 0; i < sim->grid.nn; ++i) gm += sim->grid.mass[i];
+  for (size_t i = 0; i < sim->grid.nn; ++i) gm += mpmc_grid_mass(&sim->grid, i);
   if (fabs(gm - M) > 1e-13 * M) fail_msg("grid mass %.17g, points' mass %.17g", gm, M);
   TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
   for (int a = 0; a < dim; ++a) {

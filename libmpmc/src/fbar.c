@@ -6,9 +6,13 @@
  * itself, inserted in eq 25).  The paper's recursion re-projects Jbar every step, so in a
  * long quasi-static run the smoothing of a non-uniform Jbar near boundaries accumulates
  * into a creep of the true volume (docs/theory.md); the total form has no such memory.
- * V_p is the volume at t^n, recovered as V0 J^{n+1} / dJ (G2P has already updated J).
+ * V_p is the volume at t^n.  In a step the scatter runs fused into G2P (which has the
+ * weights at x^n at hand and sets grid.fb_done); called on its own (tests) the projection
+ * scatters here, recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter
+ * leaves Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
  * Touches nothing but dF (handed to the material) and Jbar. */
 #include <math.h>
+#include <string.h>
 
 #include "transfer.h"
 
@@ -16,42 +20,61 @@
 MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
-  double *restrict gvol = g->vol, *restrict gjv = g->jv;
+  const int S = mpmc_stencil(BASIS);
+  double *restrict fb = g->fb;
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
   const double Vn = p->vol0[q] * p->J[q] / dJ;
-  const double val = sim->fbar == MPMC_FBAR_TOTAL ? p->J[q] : p->Jbar[q] * dJ;
+  const double jd = p->Jbar[q] * dJ;
+  const double val = sim->fbar == MPMC_FBAR_TOTAL ? p->J[q] : jd;
+  p->Jbar[q] = jd; /* until the gather: Jbar^n dJ, the denominator of eq 27 */
   const double Vv = Vn * val;
-  MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
-    gvol[node] += w * Vn;
-    gjv[node] += w * Vv;
+  const mpmc_v2d vv = {Vn, Vv};
+  MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
+    const mpmc_v2d cv = wyz * vv;
+    double *restrict r = fb + row * 2;
+    for (int i = 0; i < S; ++i) MPMC_V2(r + 2 * i) += pw.w[0][i] * cv;
   });
 }
 
-/* r^(1/3) for r near 1 by Newton from 1 + (r-1)/3 (three steps: relative error below 1e-16
- * for |r - 1| < 0.05); libm's cbrt elsewhere. */
+/* r^(1/3) for r near 1 (e = r - 1).  |e| < 0.004, the usual case: the Taylor polynomial to
+ * e^5 (truncation below 1e-16) in Estrin's form, a short dependency chain; |e| < 0.05:
+ * y = r^(-1/3) by Newton's division-free iteration y <- y + y (1 - r y^3) / 3 from
+ * 1 - e/3 + 2e^2/9, then r y^2; both within a few ulp (the divisions of a Newton
+ * iteration on x^3 = r made a third of the gather's time).  libm's cbrt elsewhere. */
 static inline double cbrt_near1(double r) {
   const double e = r - 1.0;
+  if (fabs(e) < 0.004) {
+    const double e2 = e * e;
+    return (1.0 + e * (1.0 / 3.0)) +
+           e2 * ((-1.0 / 9.0 + e * (5.0 / 81.0)) + e2 * (-10.0 / 243.0 + e * (22.0 / 729.0)));
+  }
   if (!(fabs(e) < 0.05)) return cbrt(r);
-  double x = 1.0 + e / 3.0;
-  for (int i = 0; i < 3; ++i) x -= (x * x * x - r) / (3.0 * x * x);
-  return x;
+  double y = 1.0 + e * (-1.0 / 3.0 + e * (2.0 / 9.0));
+  for (int i = 0; i < 2; ++i) y += y * (1.0 - r * (y * y * y)) * (1.0 / 3.0);
+  return r * y * y;
 }
 
 /* Gather point q: Pi = sum w Jbar_i, scale dF (Algorithm 1, step 4). */
 MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
-  const double *restrict gjb = g->jv;
+  const int S = mpmc_stencil(BASIS);
+  const double *restrict fb = g->fb;
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   double pi = 0.0;
-  MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, { pi += w * gjb[node]; });
+  MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
+    const double *restrict r = fb + row * 2 + 1;
+    double sr = 0.0;
+    for (int i = 0; i < S; ++i) sr += pw.w[0][i] * r[2 * i];
+    pi += wyz * sr;
+  });
   double *dF = p->dF + (size_t)q * DIM * DIM;
-  const double r = pi / (p->Jbar[q] * mpmc_det_dim(DIM, dF));
+  const double r = pi / p->Jbar[q]; /* the scatter left Jbar^n dJ there */
   const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
   for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
   p->Jbar[q] = pi;
@@ -76,11 +99,22 @@ MPMC_KERNELS(FBAR_KERNELS)
 /** Phase 4 of the step (only with F-bar on). */
 int mpmc_fbar(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
-  MPMC_KERNEL_CALL(scatter_, sim, sim);
+  /* the active box, row by row (the points' stencils lie in it) */
+  const long nrow = mpmc_grid_active_rows(g);
+  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
+  double *restrict fb = g->fb;
+  if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
+    for (long r = 0; r < nrow; ++r)
+      memset(fb + mpmc_grid_active_row(g, r) * 2, 0, len * 2 * sizeof(double));
+    MPMC_KERNEL_CALL(scatter_, sim, sim);
+  }
+  g->fb_done = 0;
   /* nodal volume average (Algorithm 1 step 3) */
-  const long nn = (long)g->nn;
-#pragma omp parallel for schedule(static) if (nn > MPMC_OMP_MIN)
-  for (long i = 0; i < nn; ++i) g->jv[i] = g->vol[i] > 0.0 ? g->jv[i] / g->vol[i] : 0.0;
+#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+  for (long r = 0; r < nrow; ++r) {
+    double *f = fb + mpmc_grid_active_row(g, r) * 2;
+    for (size_t i = 0; i < 2 * len; i += 2) f[i + 1] = f[i] > 0.0 ? f[i + 1] / f[i] : 0.0;
+  }
   MPMC_KERNEL_CALL(gather_, sim, sim);
   /* the projection used the weights at x^n; now the points move (eq 17) */
   double *t = sim->p.x;

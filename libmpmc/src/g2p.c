@@ -1,7 +1,7 @@
 /* Grid to particle: velocity with the FLIP/PIC blend (eqs 11-13), relative deformation
  * gradient dF = 1 + dt sum v_i (x) grad w (eq 16), J <- J det(dF) so that V = J V0 (eq 15),
  * position (eq 17).  With F-bar the new positions go to xn: the projection still needs the
- * weights at x^n. */
+ * weights at x^n; its scatter (fbar.c) is fused in here, where those weights are at hand. */
 #include <limits.h>
 #include <math.h>
 
@@ -14,30 +14,92 @@ typedef struct {
                              the nodes there); further out the support leaves the grid   */
 } g2p_ctx;
 
-/* Gather point q; returns 0 if its volume inverted or it left the grid. */
-MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, double dt,
-                                 const g2p_ctx *c, int q) {
-  const mpmc_grid *g = &sim->grid;
+/* Gather point q; returns 0 if its volume inverted or it left the grid.  Per row of the
+ * stencil the sums over the row's node records, sw = sum w_x rec and sd = sum w_x' rec, give
+ *   (v_pic, dv) += wyz sw,  L_a. += (wyz sd_va, dyz sw_va, ydz sw_va),
+ * all whole-vector multiply-adds in record layout; the components are picked out once.
+ * FB: also scatter the F-bar volumes V^n and V^n j of Algorithm 1 step 3 with the same
+ * weights (the points are still at x^n); the caller runs the points in slab colours. */
+MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, const int FB,
+                                 double dt, const g2p_ctx *c, int q) {
+  mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
-  const double *restrict gv = g->mom, *restrict gdv = g->force;
+  const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
+  const double *restrict rec = g->node;
   const size_t qd = (size_t)q * DIM;
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
-  double vpic[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, L[3][3] = {{0}};
-  MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
-    for (int a = 0; a < DIM; ++a) {
-      const double va = gv[node * DIM + a];
-      vpic[a] += w * va;
-      dv[a] += w * gdv[node * DIM + a];
-      for (int b = 0; b < DIM; ++b) L[a][b] += va * gw[b];
+  const mpmc_vd zero = {0.0}; /* the other lanes zero as well */
+  /* With 2-wide vectors the whole record's sums and accumulators (16 vectors) overflow the
+   * 16 SSE registers: the first sweep then takes the velocity half (v_pic, L) and the second
+   * the increment half (dv), together with the fused F-bar scatter that needs dJ. */
+  const int SPLIT = NC > 1, N1 = SPLIT ? NC : NV;
+  mpmc_vd A[MPMC_NV], B0[MPMC_NC], B1[MPMC_NC], B2[MPMC_NC];
+  for (int k = 0; k < NV; ++k) A[k] = zero;
+  for (int k = 0; k < NC; ++k) B0[k] = B1[k] = B2[k] = zero;
+  MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
+    mpmc_vd sw[MPMC_NV], sd[MPMC_NC];
+    for (int k = 0; k < N1; ++k) sw[k] = zero;
+    for (int k = 0; k < NC; ++k) sd[k] = zero;
+    const double *restrict r = rec + row * R;
+    for (int i = 0; i < S; ++i) {
+      const double wx = pw.w[0][i], dx = pw.dw[0][i];
+      const double *ri = r + i * R;
+      for (int k = 0; k < N1; ++k) sw[k] += wx * MPMC_VC(ri + MPMC_VW * k);
+      for (int k = 0; k < NC; ++k) sd[k] += dx * MPMC_VC(ri + MPMC_VW * k);
+    }
+    for (int k = 0; k < N1; ++k) A[k] += wyz * sw[k];
+    for (int k = 0; k < NC; ++k) {
+      B0[k] += wyz * sd[k];
+      B1[k] += dyz * sw[k];
+      if (DIM == 3) B2[k] += ydz * sw[k];
     }
   });
+  /* B_b = (., L_.b) in record slots */
+  double L[3][3];
+  for (int i = 0; i < DIM; ++i) {
+    const int sv = 1 + i;
+    L[i][0] = B0[sv / MPMC_VW][sv % MPMC_VW];
+    L[i][1] = B1[sv / MPMC_VW][sv % MPMC_VW];
+    if (DIM == 3) L[i][2] = B2[sv / MPMC_VW][sv % MPMC_VW];
+  }
   double *dF = p->dF + (size_t)q * DIM * DIM;
   for (int a = 0; a < DIM; ++a)
     for (int b = 0; b < DIM; ++b) dF[a * DIM + b] = (a == b) + dt * L[a][b];
   const double dJ = mpmc_det_dim(DIM, dF);
-  p->J[q] *= dJ;
+  const double Jn = p->J[q];
+  p->J[q] = Jn * dJ;
   int ok = dJ > 0.0 && isfinite(dJ);
+  mpmc_v2d vv = {0.0, 0.0};
+  if (FB) {
+    const double Vn = p->vol0[q] * Jn;
+    const double jd = p->Jbar[q] * dJ; /* kept for the gather (fbar.c) */
+    vv = (mpmc_v2d){Vn, Vn * (sim->fbar == MPMC_FBAR_TOTAL ? p->J[q] : jd)};
+    p->Jbar[q] = jd;
+  }
+  if (SPLIT || FB) {
+    double *restrict fb = g->fb;
+    MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
+      mpmc_vd sw[MPMC_NV];
+      for (int k = N1; k < NV; ++k) sw[k] = zero;
+      const double *restrict r = rec + row * R;
+      double *restrict f = FB ? fb + row * 2 : NULL;
+      const mpmc_v2d cv = wyz * vv;
+      for (int i = 0; i < S; ++i) {
+        const double wx = pw.w[0][i];
+        for (int k = N1; k < NV; ++k) sw[k] += wx * MPMC_VC(r + i * R + MPMC_VW * k);
+        if (FB) MPMC_V2(f + 2 * i) += wx * cv;
+      }
+      for (int k = N1; k < NV; ++k) A[k] += wyz * sw[k];
+    });
+  }
+  /* A = (., v_pic | dv) */
+  double vpic[3], dv[3];
+  for (int i = 0; i < DIM; ++i) {
+    const int sv = 1 + i, sf = MPMC_FOFF + i;
+    vpic[i] = A[sv / MPMC_VW][sv % MPMC_VW];
+    dv[i] = A[sf / MPMC_VW][sf % MPMC_VW];
+  }
   double *v = p->v + qd;
   for (int a = 0; a < DIM; ++a) {
     v[a] = c->eta * (v[a] + dv[a]) + (1.0 - c->eta) * vpic[a];
@@ -48,12 +110,27 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, d
   return ok;
 }
 
+/* Without F-bar the points run in index order, split evenly among the threads; with it by
+ * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
+ * fused scatter is race-free. */
 #define G2P_KERNEL(D, B)                                                                     \
   static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {           \
     int first_bad = INT_MAX;                                                                 \
     _Pragma("omp parallel for schedule(static) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
     for (int q = 0; q < sim->p.n; ++q)                                                       \
-      if (!g2p_point(sim, D, B, dt, c, q) && q < first_bad) first_bad = q;                   \
+      if (!g2p_point(sim, D, B, 0, dt, c, q) && q < first_bad) first_bad = q;                \
+    *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
+  }                                                                                          \
+  static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {         \
+    const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
+    int first_bad = INT_MAX;                                                                 \
+    for (int colour = 0; colour < 2; ++colour) {                                             \
+      _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
+      for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
+        for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
+          if (!g2p_point(sim, D, B, 1, dt, c, order[k]) && order[k] < first_bad)             \
+            first_bad = order[k];                                                            \
+    }                                                                                        \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
   }
 MPMC_KERNELS(G2P_KERNEL)
@@ -84,7 +161,12 @@ int mpmc_g2p(mpmc_sim sim, double dt) {
     c.xmax[a] = g->hi[a] + g->h;
   }
   int bad = -1;
-  MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad);
+  if (sim->fbar && g->fb) {
+    MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, &bad);
+    sim->grid.fb_done = 1;
+  } else {
+    MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad);
+  }
   if (bad >= 0) return report(sim, bad);
   return MPMC_SUCCESS;
 }

@@ -37,22 +37,29 @@ int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, c
   return MPMC_SUCCESS;
 }
 
+/* Zeroed, 64-byte aligned (a node record is then one cache line). */
 static int alloc_d(mpmc_context ctx, double **a, size_t n) {
   if (*a) return MPMC_SUCCESS;
-  *a = calloc(n, sizeof(double));
-  MPMC_CHECK(*a, ctx, MPMC_ERR_MEMORY, "cannot allocate %zu grid values", n);
+  const size_t bytes = (n * sizeof(double) + 63) / 64 * 64;
+  void *m = NULL;
+  MPMC_CHECK(posix_memalign(&m, 64, bytes) == 0, ctx, MPMC_ERR_MEMORY,
+             "cannot allocate %zu grid values", n);
+  memset(m, 0, bytes);
+  *a = m;
   return MPMC_SUCCESS;
 }
 
-int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
-  const size_t nn = g->nn, d = (size_t)g->dim;
-  MPMC_CALL(alloc_d(ctx, &g->mass, nn));
-  MPMC_CALL(alloc_d(ctx, &g->mom, nn * d));
-  MPMC_CALL(alloc_d(ctx, &g->force, nn * d));
-  if (with_fbar) {
-    MPMC_CALL(alloc_d(ctx, &g->vol, nn));
-    MPMC_CALL(alloc_d(ctx, &g->jv, nn));
+static void set_active_all(mpmc_grid *g) {
+  for (int a = 0; a < 3; ++a) {
+    g->act_lo[a] = 0;
+    g->act_hi[a] = g->n[a];
   }
+}
+
+int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
+  const size_t nn = g->nn;
+  MPMC_CALL(alloc_d(ctx, &g->node, nn * MPMC_NREC));
+  if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fb, nn * 2));
   if (!g->fixed) {
     g->fixed = calloc(nn, sizeof *g->fixed);
     MPMC_CHECK(g->fixed, ctx, MPMC_ERR_MEMORY, "cannot allocate %zu grid flags", nn);
@@ -61,23 +68,32 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
 }
 
 void mpmc_grid_clear(mpmc_grid *g, int with_fbar) {
-  const size_t nn = g->nn, d = (size_t)g->dim;
-  memset(g->mass, 0, nn * sizeof(double));
-  memset(g->mom, 0, nn * d * sizeof(double));
-  memset(g->force, 0, nn * d * sizeof(double));
-  if (with_fbar) {
-    memset(g->vol, 0, nn * sizeof(double));
-    memset(g->jv, 0, nn * sizeof(double));
+  memset(g->node, 0, g->nn * MPMC_NREC * sizeof(double));
+  if (with_fbar && g->fb) memset(g->fb, 0, g->nn * 2 * sizeof(double));
+  /* conservative: callers that clear by hand may then scatter anywhere */
+  set_active_all(g);
+  g->fb_done = 0;
+}
+
+void mpmc_grid_clear_active(mpmc_grid *g) {
+  const long nrow = mpmc_grid_active_rows(g);
+  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
+  for (long r = 0; r < nrow; ++r) {
+    const size_t first = mpmc_grid_active_row(g, r);
+    memset(g->node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
+    /* the F-bar sums whenever allocated: F-bar may have been on in an earlier step */
+    if (g->fb) memset(g->fb + first * 2, 0, len * 2 * sizeof(double));
   }
+  g->fb_done = 0;
 }
 
 void mpmc_grid_free(mpmc_grid *g) {
-  free(g->mass);
-  free(g->mom);
-  free(g->force);
-  free(g->vol);
-  free(g->jv);
+  free(g->node);
+  free(g->fb);
   free(g->fixed);
-  g->mass = g->mom = g->force = g->vol = g->jv = NULL;
+  free(g->ccount);
+  g->node = g->fb = NULL;
   g->fixed = NULL;
+  g->ccount = NULL;
+  g->cap_ccount = 0;
 }

@@ -1,38 +1,63 @@
 /* Grid update (eq 9): nodal velocities from momentum and forces, gravity, local damping,
- * wall constraints.  Leaves the new velocity in mom and the increment v^{n+1} - v^n in
- * force, which is what G2P's FLIP/PIC blend needs. */
+ * wall constraints, on the nodes of the active box.  Leaves the new velocity in the node
+ * record's momentum slots and the increment v^{n+1} - v^n in its force slots, which is what
+ * G2P's FLIP/PIC blend needs. */
 #include "mpmc_impl.h"
 
 static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   mpmc_grid *g = &sim->grid;
+  const int R = MPMC_NREC, F = MPMC_FOFF;
   const double alpha = sim->damping;
   const double *gr = sim->gravity;
-  double *restrict gm = g->mass, *restrict gp = g->mom, *restrict gf = g->force;
+  double *restrict rec = g->node;
   const unsigned short *restrict fx = g->fixed;
-  const long nn = (long)g->nn;
-#pragma omp parallel for schedule(static) if (nn > MPMC_OMP_MIN)
-  for (long i = 0; i < nn; ++i) {
-    const double m = gm[i];
-    if (m <= 0.0) continue;
-    const double inv_m = 1.0 / m;
-    double v0[3], f[3], v1[3];
-    for (int a = 0; a < DIM; ++a) {
-      v0[a] = gp[i * DIM + a] * inv_m;
-      f[a] = gf[i * DIM + a] + m * gr[a];
-    }
-    if (alpha > 0.0) mpmc_damping_apply(alpha, f, v0, DIM);
-    for (int a = 0; a < DIM; ++a) v1[a] = v0[a] + dt * f[a] * inv_m;
-    const unsigned fl = fx[i];
-    if (fl) {
+  /* only the active box holds mass */
+  const long nrow = mpmc_grid_active_rows(g);
+  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
+#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+  for (long row = 0; row < nrow; ++row) {
+    const size_t first = mpmc_grid_active_row(g, row);
+    for (size_t i = first; i < first + len; ++i) {
+      double *restrict r = rec + i * R;
+      const double m = r[0];
+      if (m <= 0.0) continue;
+      const double inv_m = 1.0 / m;
+      double v0[3], f[3], v1[3];
       for (int a = 0; a < DIM; ++a) {
-        if (fl & (1u << a)) v1[a] = 0.0;
-        if ((fl & (8u << a)) && v1[a] < 0.0) v1[a] = 0.0;
-        if ((fl & (64u << a)) && v1[a] > 0.0) v1[a] = 0.0;
+        v0[a] = r[1 + a] * inv_m;
+        f[a] = r[F + a] + m * gr[a];
+      }
+      if (alpha > 0.0) mpmc_damping_apply(alpha, f, v0, DIM);
+      for (int a = 0; a < DIM; ++a) v1[a] = v0[a] + dt * f[a] * inv_m;
+      const unsigned fl = fx[i];
+      if (fl) {
+        for (int a = 0; a < DIM; ++a) {
+          if (fl & (1u << a)) v1[a] = 0.0;
+          if ((fl & (8u << a)) && v1[a] < 0.0) v1[a] = 0.0;
+          if ((fl & (64u << a)) && v1[a] > 0.0) v1[a] = 0.0;
+        }
+      }
+      for (int a = 0; a < DIM; ++a) {
+        r[1 + a] = v1[a];
+        r[F + a] = v1[a] - v0[a];
       }
     }
-    for (int a = 0; a < DIM; ++a) {
-      gp[i * DIM + a] = v1[a];
-      gf[i * DIM + a] = v1[a] - v0[a];
+  }
+}
+
+/* The ghosts in the active box fold into partners across the wall that may lie outside it:
+ * grow the box to hold them (nodes outside it are zero, so nothing needs clearing). */
+static void grow_box_for_mirrors(mpmc_sim sim) {
+  mpmc_grid *g = &sim->grid;
+  for (int w = 0; w < sim->nmirror; ++w) {
+    const mpmc_mirror *m = &sim->mirrors[w];
+    const int a = m->axis;
+    if (g->act_hi[a] <= g->act_lo[a]) continue;
+    for (int k = 1; k <= MPMC_GHOST; ++k) {
+      const int ig = m->plane + m->side * k, im = m->plane - m->side * k;
+      if (ig < g->act_lo[a] || ig >= g->act_hi[a] || im < 0 || im >= g->n[a]) continue;
+      if (im < g->act_lo[a]) g->act_lo[a] = im;
+      if (im >= g->act_hi[a]) g->act_hi[a] = im + 1;
     }
   }
 }
@@ -46,33 +71,36 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
 static void mirror_ghosts(mpmc_sim sim, int fold) {
   mpmc_grid *g = &sim->grid;
   const int d = sim->dim;
-  double *gm = g->mass, *gv = g->mom, *gf = g->force;
+  const size_t R = MPMC_NREC, F = MPMC_FOFF;
+  double *rec = g->node;
   const size_t stride[3] = {1, (size_t)g->n[0], (size_t)g->n[0] * (size_t)g->n[1]};
   for (int w = 0; w < sim->nmirror; ++w) {
     const mpmc_mirror *m = &sim->mirrors[w];
     const int a = m->axis, b = (a + 1) % d, c = (a + 2) % d;
     for (int k = 1; k <= MPMC_GHOST; ++k) {
       const int ig = m->plane + m->side * k, im = m->plane - m->side * k;
-      if (ig < 0 || ig >= g->n[a] || im < 0 || im >= g->n[a]) continue;
-      for (int j = 0; j < g->n[b]; ++j)
-        for (int l = 0; l < (d == 3 ? g->n[c] : 1); ++l) {
+      /* ghosts with mass lie in the active box */
+      if (ig < g->act_lo[a] || ig >= g->act_hi[a] || im < 0 || im >= g->n[a]) continue;
+      for (int j = g->act_lo[b]; j < g->act_hi[b]; ++j)
+        for (int l = (d == 3 ? g->act_lo[c] : 0); l < (d == 3 ? g->act_hi[c] : 1); ++l) {
           const size_t base = stride[b] * (size_t)j + (d == 3 ? stride[c] * (size_t)l : 0);
-          const size_t ng = base + stride[a] * (size_t)ig, nm = base + stride[a] * (size_t)im;
-          if (gm[ng] <= 0.0) continue;
+          double *rg = rec + R * (base + stride[a] * (size_t)ig);
+          double *rm = rec + R * (base + stride[a] * (size_t)im);
+          if (rg[0] <= 0.0) continue;
           if (fold) {
             for (int e = 0; e < d; ++e) {
               const double sg = (m->odd >> e & 1u) ? -1.0 : 1.0;
-              gv[nm * d + e] += sg * gv[ng * d + e];
+              rm[1 + e] += sg * rg[1 + e];
               /* gravity enters the update as (folded mass) * g; the ghost's share of the
                * body force belongs to the partner with the reflection's sign */
-              gf[nm * d + e] += sg * gf[ng * d + e] + (sg - 1.0) * gm[ng] * sim->gravity[e];
+              rm[F + e] += sg * rg[F + e] + (sg - 1.0) * rg[0] * sim->gravity[e];
             }
-            gm[nm] += gm[ng];
+            rm[0] += rg[0];
           } else {
             for (int e = 0; e < d; ++e) {
               const double sg = (m->odd >> e & 1u) ? -1.0 : 1.0;
-              gv[ng * d + e] = sg * gv[nm * d + e];
-              gf[ng * d + e] = sg * gf[nm * d + e];
+              rg[1 + e] = sg * rm[1 + e];
+              rg[F + e] = sg * rm[F + e];
             }
           }
         }
@@ -83,7 +111,10 @@ static void mirror_ghosts(mpmc_sim sim, int fold) {
 /** Phase 2 of the step. */
 int mpmc_grid_update(mpmc_sim sim, double dt) {
   if (sim->walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim));
-  if (sim->nmirror) mirror_ghosts(sim, 1);
+  if (sim->nmirror) {
+    grow_box_for_mirrors(sim);
+    mirror_ghosts(sim, 1);
+  }
   if (sim->dim == 2)
     update_impl(sim, 2, dt);
   else

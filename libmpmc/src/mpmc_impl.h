@@ -70,6 +70,11 @@ void mpmc_particles_free(mpmc_particles *p);
 
 /* ---- grid (grid.c) ------------------------------------------------------------------ */
 #define MPMC_GHOST 3 /* ghost cells outside the user box on each side (cubic needs 2) */
+/* Doubles per node record, one cache line: slot 0 mass, 1 .. dim momentum, MPMC_FOFF ..
+ * MPMC_FOFF + dim - 1 force, the rest zero (P2G adds to and G2P reads from one line per node,
+ * in whole vectors of 2 or 4 doubles: the halves are mass-momentum and force). */
+#define MPMC_NREC 8
+#define MPMC_FOFF 4
 typedef struct {
   int dim;
   double lo[3], hi[3]; /* user box                                                */
@@ -77,20 +82,44 @@ typedef struct {
   double origin[3];    /* position of node 0 (lo - GHOST*h)                        */
   int n[3];            /* nodes per axis (1 in unused axes)                         */
   size_t nn;           /* total nodes                                              */
-  double *mass;        /* [nn]                                                     */
-  double *mom;         /* [nn][dim] momentum, then new velocity after grid update   */
-  double *force;       /* [nn][dim] f_int + f_ext, then velocity increment          */
-  double *vol;         /* [nn] F-bar: sum w V                                       */
-  double *jv;          /* [nn] F-bar: sum w V (Jbar dJ), then nodal Jbar            */
+  double *node;        /* [nn][MPMC_NREC] mass, momentum, f_int + f_ext (slots above); after
+                          the grid update mass, new velocity, velocity increment         */
+  double *fb;          /* [nn][2] F-bar: sum w V, sum w V (Jbar dJ) then nodal Jbar   */
   unsigned short *fixed; /* [nn] bit a: component a fixed; bit 3+a: v_a >= 0 only; bit 6+a: v_a <= 0 only */
+  /* node index box [act_lo, act_hi) per axis outside which node and fb are zero: the points'
+   * stencils of the last P2G (and the mirror partners the grid update folded into); P2G
+   * clears only this box and the grid update visits only it */
+  int act_lo[3], act_hi[3];
+  int fb_done;         /* G2P scattered this step's F-bar volumes (fused, race-free)     */
+  int *ccount;         /* p2g.c scratch: points per plane of cells, slab fill positions   */
+  size_t cap_ccount;
   int valid;
 } mpmc_grid;
 
 int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, const double *hi,
                     double h);
 int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar);
+/* zero the whole grid (with_fbar: the F-bar sums too) */
 void mpmc_grid_clear(mpmc_grid *g, int with_fbar);
+/* zero the active box only (the hot path: everything outside it is zero already) */
+void mpmc_grid_clear_active(mpmc_grid *g);
 void mpmc_grid_free(mpmc_grid *g);
+/* The active box as rows of nodes along x: their number, and the first node of row r (each
+ * row holds act_hi[0] - act_lo[0] consecutive nodes). */
+static inline long mpmc_grid_active_rows(const mpmc_grid *g) {
+  const long ny = g->act_hi[1] - g->act_lo[1], nz = g->act_hi[2] - g->act_lo[2];
+  return g->act_hi[0] > g->act_lo[0] && ny > 0 && nz > 0 ? ny * nz : 0;
+}
+static inline size_t mpmc_grid_active_row(const mpmc_grid *g, long r) {
+  const long ny = g->act_hi[1] - g->act_lo[1];
+  return (size_t)g->act_lo[0] +
+         (size_t)g->n[0] * ((size_t)(g->act_lo[1] + r % ny) +
+                            (size_t)g->n[1] * (size_t)(g->act_lo[2] + r / ny));
+}
+/* nodal mass of node i (after P2G) */
+static inline double mpmc_grid_mass(const mpmc_grid *g, size_t i) {
+  return g->node[i * MPMC_NREC];
+}
 
 /* ---- materials (material.c, material_*.c) ------------------------------------------- */
 typedef enum {
@@ -194,8 +223,9 @@ struct mpmc_sim_s {
   double time;
   mpmc_stats stats;
   void *solver_ws;    /* return-mapping workspaces (return_map.c), per thread          */
-  /* race-free scatter (p2g.c): points bucketed into slabs of MPMC_SLAB_W cells along one
-   * axis; slabs of one colour (parity) never touch the same node, so they run in parallel */
+  /* race-free scatter (p2g.c): points bucketed into slabs of at least MPMC_SLAB_W cells
+   * along one axis; slabs of one colour (parity) never touch the same node, so they run in
+   * parallel */
   int *order;         /* [n] point indices grouped by slab                             */
   int *slab_start;    /* [nslab + 1] offsets into order                                */
   int nslab, slab_axis, cap_order, cap_slab;
@@ -205,8 +235,9 @@ struct mpmc_sim_s {
   mpmc_monitor monitor;         /* energy check after each step (monitor.c)           */
 };
 
-/* Slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic), so two
- * slabs of the same parity, one slab apart, share no node when the width exceeds 2. */
+/* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),
+ * so two slabs of the same parity, one slab apart, share no node when the slab between them
+ * is wider than 2 cells (slabs are widened beyond this to balance the points per thread). */
 #define MPMC_SLAB_W 3
 int mpmc_slabs_build(struct mpmc_sim_s *sim);
 

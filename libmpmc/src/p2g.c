@@ -1,71 +1,152 @@
 /* Particle to grid: mass (eq 7), momentum (eq 8), internal force (eq 10) and the points'
  * external forces.  Threads scatter without atomics: the points are bucketed by slab
  * (mpmc_slabs_build) and the slabs of one parity run in parallel, then the other parity. */
+#include <math.h>
 #include <stdlib.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "transfer.h"
 
-/* Bucket the points into slabs of MPMC_SLAB_W cells along one axis (a counting sort of
- * indices; the particle arrays themselves are not moved, so indices held
- * by callers and particle sets stay valid). */
+/* Bucket the points into slabs of whole cell planes along one axis (a stable counting sort
+ * of indices; the particle arrays themselves are not moved, so indices held by callers,
+ * particle sets and rigid-body anchors stay valid), and set the grid's active box to the
+ * nodes the points' stencils reach.  Within a slab the points keep their index order: with
+ * the points shuffled, visiting them by cell instead (grid in order, particle arrays at
+ * random) was slower than this (particle arrays in order, grid at random) on the 3D column.
+ * Slabs of one parity run in parallel: a point in cell c touches nodes c-1 .. c+2 at most
+ * (cubic), so two slabs with one slab of at least MPMC_SLAB_W = 3 cells between them share no
+ * node.  The slab boundaries balance the points: about 2 x threads slabs or a multiple, so
+ * each thread gets the same share of each colour (fixed-width slabs left one of two threads
+ * idle for a third of P2G in the 3D column).  Results depend on the thread count only
+ * through the summation order at the nodes that two slabs share. */
 int mpmc_slabs_build(mpmc_sim sim) {
-  const mpmc_grid *g = &sim->grid;
+  mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
-  /* the outermost axis of the node numbering (z in 3D, y in 2D): a slab's nodes are then one
-   * contiguous block, and so are its points when they were seeded in lattice order; another
-   * axis only when this one has too few slabs to keep two threads busy */
-  int axis = d - 1;
-  if (g->n[axis] / MPMC_SLAB_W < 8)
-    for (int a = 0; a < d; ++a)
-      if (g->n[a] > g->n[axis]) axis = a;
-  const int nslab = g->n[axis] / MPMC_SLAB_W + 1;
-  if (p->n > sim->cap_order) {
-    int *o = realloc(sim->order, sizeof(int) * (size_t)p->n);
-    MPMC_CHECK(o, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the slab order of %d points", p->n);
+  const int d = sim->dim, n = p->n;
+  const double ih = g->inv_h;
+  if (n > sim->cap_order) {
+    int *o = realloc(sim->order, sizeof(int) * (size_t)n);
+    MPMC_CHECK(o, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the slab order of %d points", n);
     sim->order = o;
-    sim->cap_order = p->n;
+    sim->cap_order = n;
   }
-  if (nslab + 1 > sim->cap_slab) {
-    int *st = realloc(sim->slab_start, sizeof(int) * (size_t)(nslab + 1));
-    MPMC_CHECK(st, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %d slabs", nslab);
+  /* one pass over the points: the cells holding points, and how many lie in each plane of
+   * cells along every axis (the points stay within one cell of the box, g2p checks, well
+   * inside the ghost layers, so the cell coordinates are positive) */
+  size_t need = 1;
+  for (int a = 0; a < d; ++a) need += 2 * (size_t)g->n[a];
+  if (need > g->cap_ccount) {
+    int *c = realloc(g->ccount, sizeof(int) * need);
+    MPMC_CHECK(c, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %zu plane counts", need);
+    g->ccount = c;
+    g->cap_ccount = need;
+  }
+  int *hist[3] = {NULL, NULL, NULL}, *fill = g->ccount;
+  for (int a = 0; a < d; ++a) {
+    hist[a] = fill;
+    for (int k = 0; k < g->n[a]; ++k) hist[a][k] = 0;
+    fill += g->n[a];
+  }
+  int clo[3] = {0, 0, 0}, chi[3] = {0, 0, 0};
+  for (int a = 0; a < d; ++a) {
+    clo[a] = g->n[a];
+    chi[a] = -1;
+  }
+  for (int q = 0; q < n; ++q) {
+    const double *x = p->x + (size_t)q * d;
+    for (int a = 0; a < d; ++a) {
+      const int c = (int)((x[a] - g->origin[a]) * ih);
+      clo[a] = c < clo[a] ? c : clo[a];
+      chi[a] = c > chi[a] ? c : chi[a];
+      hist[a][c]++;
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    const int lo = a < d ? clo[a] - 1 : 0, hi = a < d ? chi[a] + 3 : 1;
+    g->act_lo[a] = lo < 0 ? 0 : lo;
+    g->act_hi[a] = hi > g->n[a] ? g->n[a] : hi;
+  }
+  if (n == 0) {
+    for (int a = 0; a < 3; ++a) g->act_lo[a] = g->act_hi[a] = 0;
+    sim->nslab = 0;
+    return MPMC_SUCCESS;
+  }
+  /* slab axis: the longest extent of the points (ties: the outermost, whose slabs are
+   * contiguous blocks of nodes) */
+  int ax = d - 1;
+  for (int a = d - 2; a >= 0; --a)
+    if (chi[a] - clo[a] > chi[ax] - clo[ax]) ax = a;
+#ifdef _OPENMP
+  const int nt = omp_get_max_threads();
+#else
+  const int nt = 1;
+#endif
+  const int np = chi[ax] - clo[ax] + 1; /* planes */
+  const int per = np / (MPMC_SLAB_W * 2 * nt);
+  const double share = (double)n / (2 * nt * (per < 1 ? 1 : per));
+  const int cap = np / MPMC_SLAB_W + 2;
+  if (cap > sim->cap_slab) {
+    int *st = realloc(sim->slab_start, sizeof(int) * (size_t)cap);
+    MPMC_CHECK(st, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %d slabs", cap);
     sim->slab_start = st;
-    sim->cap_slab = nslab + 1;
+    sim->cap_slab = cap;
   }
-  int *start = sim->slab_start, *order = sim->order;
-  for (int s = 0; s <= nslab; ++s) start[s] = 0;
-  const double o = g->origin[axis], ih = g->inv_h;
-  /* points stay within one cell of the box (g2p checks), well inside the ghost layers */
-  for (int q = 0; q < p->n; ++q) {
-    const int c = (int)((p->x[(size_t)q * d + axis] - o) * ih);
-    start[c / MPMC_SLAB_W + 1]++;
-  }
-  for (int s = 0; s < nslab; ++s) start[s + 1] += start[s];
-  for (int q = 0; q < p->n; ++q) {
-    const int c = (int)((p->x[(size_t)q * d + axis] - o) * ih);
-    order[start[c / MPMC_SLAB_W]++] = q;
-  }
-  for (int s = nslab; s > 0; --s) start[s] = start[s - 1];
+  /* close a slab once it holds its share of the points and is at least MPMC_SLAB_W planes
+   * wide (the last one may be narrower: no slab of its colour lies beyond it); each plane's
+   * count is replaced by its slab */
+  int *start = sim->slab_start, *slab_of = hist[ax] + clo[ax], ns = 0, width = 0, sum = 0;
   start[0] = 0;
-  sim->nslab = nslab;
-  sim->slab_axis = axis;
+  for (int pl = 0; pl < np; ++pl) {
+    sum += slab_of[pl];
+    slab_of[pl] = ns;
+    ++width;
+    if (pl == np - 1 || (width >= MPMC_SLAB_W && sum >= share * (ns + 1))) {
+      start[++ns] = sum;
+      width = 0;
+    }
+  }
+  /* stable placement */
+  for (int s = 0; s < ns; ++s) fill[s] = start[s];
+  const double o = g->origin[ax];
+  int *order = sim->order;
+  for (int q = 0; q < n; ++q)
+    order[fill[slab_of[(int)((p->x[(size_t)q * d + ax] - o) * ih) - clo[ax]]]++] = q;
+  sim->nslab = ns;
+  sim->slab_axis = ax;
   return MPMC_SUCCESS;
 }
 
-/* Scatter point q: mass, momentum and force w m, w m v, -V sigma grad w + w f_ext. */
+/* Value of record slot s for mass m, momentum mv and force f (vectors of DIM); with DIM and s
+ * constants this folds to one of them. */
+MPMC_ALWAYS_INLINE double rec_slot(const int DIM, int s, double m, const double *mv,
+                                   const double *f) {
+  return s == 0                               ? m
+         : s <= DIM                           ? mv[s - 1]
+         : s >= MPMC_FOFF && s < MPMC_FOFF + DIM ? f[s - MPMC_FOFF]
+                                              : 0.0;
+}
+
+/* Scatter point q: mass, momentum and force w m, w m v, -V sigma grad w + w f_ext, all
+ * into the node records.  Per row of the stencil the record's increment splits as
+ *   rec += w_x c + w_x' e,  c = wyz (m, m v, f_ext) + dyz (-V sigma_.1) + ydz (-V sigma_.2),
+ *                           e = wyz (-V sigma_.0)
+ * (grad w = (w_x' wyz, w_x dyz, w_x ydz)), with c and e fixed along the row: per node a few
+ * whole-vector multiply-adds on one record. */
 MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
-  double *restrict gm = g->mass, *restrict gp = g->mom, *restrict gf = g->force;
+  const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
+  double *restrict rec = g->node;
   const size_t qd = (size_t)q * DIM;
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const double m = p->m[q];
-  double mv[3] = {0, 0, 0};
-  for (int a = 0; a < DIM; ++a) mv[a] = m * p->v[qd + a];
   const double V = p->vol0[q] * p->J[q];
   const double *s = p->stress + (size_t)q * 6;
-  /* -V sigma, rows of the (symmetric) stress in the dim-dimensional subspace */
+  /* -V sigma, rows of the (symmetric) stress in the dim-dimensional subspace; being
+   * symmetric, row b is also column b */
   double vs[3][3];
   vs[0][0] = -V * s[0];
   vs[1][1] = -V * s[1];
@@ -73,18 +154,44 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS, 
   vs[1][2] = vs[2][1] = -V * s[3];
   vs[0][2] = vs[2][0] = -V * s[4];
   vs[0][1] = vs[1][0] = -V * s[5];
-  double fe[3] = {0, 0, 0};
-  if (p->force)
-    for (int a = 0; a < DIM; ++a) fe[a] = p->force[qd + a];
-  if (p->cforce)
-    for (int a = 0; a < DIM; ++a) fe[a] += p->cforce[qd + a];
-  MPMC_STENCIL_LOOP(DIM, BASIS, g, pw, {
-    gm[node] += w * m;
-    for (int a = 0; a < DIM; ++a) {
-      double f = w * fe[a];
-      for (int b = 0; b < DIM; ++b) f += vs[a][b] * gw[b];
-      gp[node * DIM + a] += w * mv[a];
-      gf[node * DIM + a] += f;
+  double mv[3] = {0, 0, 0}, fe[3] = {0, 0, 0};
+  for (int a = 0; a < DIM; ++a) {
+    mv[a] = m * p->v[qd + a];
+    if (p->force) fe[a] = p->force[qd + a];
+    if (p->cforce) fe[a] += p->cforce[qd + a];
+  }
+  /* record-shaped factors (m, m v | f_ext) and (0, 0 | -V sigma_.b), built in registers (a
+   * round trip through memory would stall on store forwarding) */
+  static const double zero3[3] = {0, 0, 0};
+#define MF_(sl) rec_slot(DIM, sl, m, mv, fe)
+#define S0_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[0])
+#define S1_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[1])
+#define S2_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[2])
+  mpmc_vd MF[MPMC_NV], S0[MPMC_NV], S1[MPMC_NV], S2[MPMC_NV];
+  for (int k = 0; k < NV; ++k) {
+    MF[k] = MPMC_VSET(MF_, k);
+    S0[k] = MPMC_VSET(S0_, k);
+    S1[k] = MPMC_VSET(S1_, k);
+    S2[k] = MPMC_VSET(S2_, k);
+  }
+#undef MF_
+#undef S0_
+#undef S1_
+#undef S2_
+  MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
+    mpmc_vd c[MPMC_NV], e[MPMC_NV];
+    for (int k = 0; k < NC; ++k) c[k] = wyz * MF[k];
+    for (int k = NC; k < NV; ++k) {
+      c[k] = wyz * MF[k] + dyz * S1[k];
+      if (DIM == 3) c[k] += ydz * S2[k];
+      e[k] = wyz * S0[k];
+    }
+    double *restrict r = rec + row * R;
+    for (int i = 0; i < S; ++i) {
+      const double wx = pw.w[0][i], dx = pw.dw[0][i];
+      double *ri = r + i * R;
+      for (int k = 0; k < NC; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k];
+      for (int k = NC; k < NV; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k] + dx * e[k];
     }
   });
 }
@@ -103,8 +210,8 @@ MPMC_KERNELS(P2G_KERNEL)
 /** Phase 1 of the step: reset the grid and scatter the points onto it. */
 int mpmc_p2g(mpmc_sim sim, double dt) {
   (void)dt;
-  mpmc_grid_clear(&sim->grid, sim->fbar);
-  MPMC_CALL(mpmc_slabs_build(sim));
+  mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
+  MPMC_CALL(mpmc_slabs_build(sim));    /* ... and this step's box */
   MPMC_KERNEL_CALL(p2g_, sim, sim);
   return MPMC_SUCCESS;
 }
