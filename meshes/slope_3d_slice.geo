@@ -5,9 +5,13 @@
 // uniform across y, so the slice and the 5 m slope solve the same plane-strain problem in
 // 3D (docs/landslide.md compares the two); the slice has 6.25x fewer points.
 // 0.8 m is a whole number of cells at 0.4 m and 0.2 m (and at 0.1 m, 0.16 m, 0.266.. m).
+// A file that sets Wd and then includes this one makes another width
+// (meshes/slope_3d_strip.geo: one 0.2 m cell across).
 Hs = 5.0;      // slope height
 Lc = 9.95;     // crest plateau length
-Wd = 0.8;      // width across the slope (the full scene: 5 m)
+If (!Exists(Wd))
+  Wd = 0.8;    // width across the slope (the full scene: 5 m)
+EndIf
 lc = 1.5;
 Point(1) = {0, 0, 0, lc};
 Point(2) = {Lc + Hs, 0, 0, lc}; // toe
