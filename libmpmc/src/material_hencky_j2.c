@@ -18,6 +18,15 @@
 #include "linalg.h"
 #include "return_map.h"
 
+/* The trial state's record in info; 0 for a finite trial stress, MPMC_ERR_NUMERIC else. */
+static inline int trial_info(mpmc_j2_info *info, double qtr, double k0) {
+  info->q_trial = qtr;
+  info->kappa = k0;
+  info->plastic = 0;
+  info->dgamma = 0.0;
+  return isfinite(qtr) ? 0 : MPMC_ERR_NUMERIC;
+}
+
 /* The eigen path: principal logarithmic strains of any positive definite trial b (the
  * fast path's fallback for |eps| >~ 0.18). */
 static int return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, const double *b,
@@ -37,11 +46,7 @@ static int return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, co
   }
   const double qtr = sqrt(1.5 * ss);
   const double k0 = mpmc_j2_kappa(m, *eps_p);
-  info->q_trial = qtr;
-  info->kappa = k0;
-  info->plastic = 0;
-  info->dgamma = 0.0;
-  if (!isfinite(qtr)) return MPMC_ERR_NUMERIC;
+  MPMC_CALL(trial_info(info, qtr, k0));
   double t[3];
   if (qtr > k0) {
     double dg, qn;
@@ -100,11 +105,7 @@ static inline int return_map_point(mpmc_rm_ws *ws, int solver, const mpmc_j2_par
   const double qtr = sqrt(1.5 * mpmc_sym3_norm2(e)) * G2;
   double J;
   const double k0 = mpmc_j2_kappa(m, *eps_p);
-  info->q_trial = qtr;
-  info->kappa = k0;
-  info->plastic = 0;
-  info->dgamma = 0.0;
-  if (!isfinite(qtr)) return MPMC_ERR_NUMERIC;
+  MPMC_CALL(trial_info(info, qtr, k0));
   if (qtr > k0) {
     double dg, qn, en[6], bn[6];
     info->plastic = 1;
