@@ -11,13 +11,8 @@
 #include "linalg.h"
 #include "test_util.h"
 
-static unsigned long long rng_state = 0x9E3779B97F4A7C15ull;
-static double urand(void) { /* xorshift64*, uniform in [0, 1) */
-  rng_state ^= rng_state >> 12;
-  rng_state ^= rng_state << 25;
-  rng_state ^= rng_state >> 27;
-  return (double)((rng_state * 2685821657736338717ull) >> 11) * 0x1.0p-53;
-}
+#define TEST_RNG_SEED 0x9E3779B97F4A7C15ull
+#include "test_rand.h"
 
 static void sort3(double *v) {
   for (int i = 0; i < 3; ++i)
@@ -27,20 +22,6 @@ static void sort3(double *v) {
         v[i] = v[j];
         v[j] = t;
       }
-}
-
-/* A random rotation from a random unit quaternion. */
-static void rand_rotation(double R[3][3]) {
-  double q[4], n = 0;
-  for (int i = 0; i < 4; ++i) {
-    q[i] = 2 * urand() - 1;
-    n += q[i] * q[i];
-  }
-  n = sqrt(n);
-  const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
-  R[0][0] = 1 - 2 * (y * y + z * z); R[0][1] = 2 * (x * y - z * w); R[0][2] = 2 * (x * z + y * w);
-  R[1][0] = 2 * (x * y + z * w); R[1][1] = 1 - 2 * (x * x + z * z); R[1][2] = 2 * (y * z - x * w);
-  R[2][0] = 2 * (x * z - y * w); R[2][1] = 2 * (y * z + x * w); R[2][2] = 1 - 2 * (x * x + y * y);
 }
 
 static void check_one(const double *s, int k) {

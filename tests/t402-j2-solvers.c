@@ -14,27 +14,8 @@
 #include "return_map.h"
 #include "test_util.h"
 
-static unsigned long long rng_state = 0x2545F4914F6CDD1Dull;
-static double urand(void) {
-  rng_state ^= rng_state >> 12;
-  rng_state ^= rng_state << 25;
-  rng_state ^= rng_state >> 27;
-  return (double)((rng_state * 2685821657736338717ull) >> 11) * 0x1.0p-53;
-}
-static double loguni(double a, double b) { return a * pow(b / a, urand()); }
-
-static void rand_rotation(double R[3][3]) {
-  double q[4], n = 0;
-  for (int i = 0; i < 4; ++i) {
-    q[i] = 2 * urand() - 1;
-    n += q[i] * q[i];
-  }
-  n = sqrt(n);
-  const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
-  R[0][0] = 1 - 2 * (y * y + z * z); R[0][1] = 2 * (x * y - z * w); R[0][2] = 2 * (x * z + y * w);
-  R[1][0] = 2 * (x * y + z * w); R[1][1] = 1 - 2 * (x * x + z * z); R[1][2] = 2 * (y * z - x * w);
-  R[2][0] = 2 * (x * z - y * w); R[2][1] = 2 * (y * z + x * w); R[2][2] = 1 - 2 * (x * x + y * y);
-}
+#define TEST_RNG_SEED 0x2545F4914F6CDD1Dull
+#include "test_rand.h"
 
 /* von Mises stress of a Kirchhoff tensor (Voigt) */
 static double vm(const double *t) {
