@@ -43,6 +43,9 @@ module mpmc
   ! local solvers
   integer(c_int), parameter, public :: MPMC_SOLVER_AUTO = 0, MPMC_SOLVER_NEWTON = 1, &
     MPMC_SOLVER_KINSOL = 2
+  ! instruction set of the transfer kernels (the same results to the bit)
+  integer(c_int), parameter, public :: MPMC_KERNELS_AUTO = 0, MPMC_KERNELS_BASELINE = 1, &
+    MPMC_KERNELS_AVX2 = 2
   ! particle fields
   integer(c_int), parameter, public :: MPMC_FIELD_POSITION = 0, MPMC_FIELD_VELOCITY = 1, &
     MPMC_FIELD_MASS = 2, MPMC_FIELD_VOLUME0 = 3, MPMC_FIELD_J = 4, MPMC_FIELD_JBAR = 5, &
@@ -98,7 +101,7 @@ module mpmc
   public :: mpmc_sim_create, mpmc_sim_destroy, mpmc_sim_get_context, mpmc_sim_get_dim, &
     mpmc_sim_set_grid, mpmc_sim_get_grid, mpmc_sim_set_basis, mpmc_sim_set_fbar, &
     mpmc_sim_get_fbar, mpmc_sim_set_flip_blend, mpmc_sim_set_gravity, mpmc_sim_set_damping, &
-    mpmc_sim_set_solver, mpmc_sim_set_threads
+    mpmc_sim_set_solver, mpmc_sim_set_threads, mpmc_sim_set_kernels, mpmc_sim_get_kernels
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
@@ -257,6 +260,18 @@ module mpmc
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
       integer(c_int), value :: solver
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_kernels(sim, kernels) bind(C, name='mpmc_sim_set_kernels') result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: kernels
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_kernels(sim, kernels) bind(C, name='mpmc_sim_get_kernels') result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), intent(out) :: kernels
       integer(c_int) :: ierr
     end function
     function mpmc_sim_set_threads(sim, nthreads) bind(C, name='mpmc_sim_set_threads') result(ierr)

@@ -52,6 +52,16 @@ program t011_errors_f
   call expect_int('a point outside the box', MPMC_ERR_OUTSIDE, ierr)
   call expect_has('message of the point outside', mpmc_context_last_error(ctx), &
     'coordinate 0 = 1.5 outside the grid box [0, 1]')
+  ! kernel sets: a bad value names the parameter; BASELINE is always there and reads back
+  ierr = mpmc_sim_set_kernels(sim, 7_c_int)
+  call expect_int('mpmc_sim_set_kernels(7)', MPMC_ERR_ARG, ierr)
+  call expect_has('message of set_kernels(7)', mpmc_context_last_error(ctx), 'kernels = 7')
+  call check(mpmc_sim_set_kernels(sim, MPMC_KERNELS_BASELINE) == MPMC_SUCCESS, 'set_kernels(BASELINE)')
+  call check(mpmc_sim_get_kernels(sim, id) == MPMC_SUCCESS .and. id == MPMC_KERNELS_BASELINE, &
+    'get_kernels = BASELINE')
+  call check(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AUTO) == MPMC_SUCCESS, 'set_kernels(AUTO)')
+  call check(mpmc_sim_get_kernels(sim, id) == MPMC_SUCCESS .and. (id == MPMC_KERNELS_BASELINE &
+    .or. id == MPMC_KERNELS_AVX2), 'get_kernels after AUTO is a concrete set')
   ! clearing forgets the message
   call check(mpmc_context_clear_error(ctx) == MPMC_SUCCESS, 'mpmc_context_clear_error')
   call expect_str('message after clear', '', mpmc_context_last_error(ctx))

@@ -198,6 +198,10 @@ static int build(wf_run *w) {
   return 0;
 }
 
+static const char *kernels_name(int k) {
+  return k == MPMC_KERNELS_AVX2 ? "avx2 (x86-64-v3)" : "baseline";
+}
+
 static void log_plan(const wf_run *w) {
   const wf_scene *sc = &w->sc;
   int np = 0, plastic = 0, gmsh = 0, damping = 0, tractions = 0, walls = 0, srf = 0;
@@ -235,6 +239,9 @@ static void log_plan(const wf_run *w) {
 #undef FEATURE
   say(w, "enabled: %s", on[0] ? on : "nothing optional");
   say(w, "left out: %s", off[0] ? off : "nothing");
+  int kern = MPMC_KERNELS_BASELINE;
+  if (w->sim) mpmc_sim_get_kernels(w->sim, &kern);
+  say(w, "kernels: %s", kernels_name(kern));
   for (int i = 0; i < sc->nmat; ++i) {
     const wf_material *m = &sc->mats[i];
     if (m->model == WF_MODEL_HENCKY_J2)
@@ -575,6 +582,9 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
   }
   fprintf(f, "  \"dim\": %d,\n  \"basis\": \"%s\",\n  \"fbar\": %s,\n  \"cell_size\": %.9g,\n", w->sc.dim,
           wf_basis_name(w->sc.basis), w->sc.fbar == MPMC_FBAR_TOTAL ? "\"total\"" : w->sc.fbar ? "true" : "false", w->sc.h);
+  int kern = MPMC_KERNELS_BASELINE;
+  mpmc_sim_get_kernels(w->sim, &kern);
+  fprintf(f, "  \"kernels\": \"%s\",\n", kern == MPMC_KERNELS_AVX2 ? "avx2" : "baseline");
   fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
   fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
           st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);

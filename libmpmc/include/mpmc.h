@@ -76,6 +76,17 @@ typedef enum {
   MPMC_SOLVER_KINSOL = 2  /* SUNDIALS KINSOL with line search only               */
 } mpmc_solver;
 
+/* Instruction set of the step's transfer kernels (P2G, grid update, G2P, F-bar;
+ * mpmc_sim_set_kernels).  On x86-64 the library carries them twice, for any x86-64 and for
+ * x86-64-v3 (AVX2); both give the same results to the bit (no fused multiply-adds). */
+typedef enum {
+  MPMC_KERNELS_AUTO = 0,     /* AVX2 where the processor has it (the default); the    */
+                             /* environment variable MPMC_KERNELS=baseline|avx2|auto */
+                             /* read by mpmc_sim_create overrides the default        */
+  MPMC_KERNELS_BASELINE = 1, /* the build's own target (any x86-64 by default)       */
+  MPMC_KERNELS_AVX2 = 2      /* x86-64-v3; refused where the build or CPU lacks it    */
+} mpmc_kernels;
+
 /* Particle fields, readable (and writable) in place.  ncomp per particle in brackets. */
 typedef enum {
   MPMC_FIELD_POSITION = 0, /* [dim]                                                  */
@@ -130,6 +141,8 @@ int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
 int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
 int mpmc_sim_set_solver(mpmc_sim sim, int solver);
 int mpmc_sim_set_threads(mpmc_sim sim, int nthreads);
+int mpmc_sim_set_kernels(mpmc_sim sim, int kernels);      /* mpmc_kernels */
+int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels); /* the set in use: BASELINE or AVX2 */
 
 /* ---- materials; each returns its id ----------------------------------------- */
 int mpmc_sim_add_material_neo_hookean(mpmc_sim sim, double E, double nu, double rho, int *id);

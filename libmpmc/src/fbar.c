@@ -97,7 +97,7 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
 MPMC_KERNELS(FBAR_KERNELS)
 
 /** Phase 4 of the step (only with F-bar on). */
-int mpmc_fbar(mpmc_sim sim) {
+int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   /* the active box, row by row (the points' stencils lie in it) */
   const long nrow = mpmc_grid_active_rows(g);

@@ -153,7 +153,7 @@ static int report(mpmc_sim sim, int q) {
 }
 
 /** Phase 3 of the step. */
-int mpmc_g2p(mpmc_sim sim, double dt) {
+int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   const mpmc_grid *g = &sim->grid;
   g2p_ctx c = {.eta = sim->flip, .xout = sim->fbar ? sim->p.xn : sim->p.x};
   for (int a = 0; a < sim->dim; ++a) {

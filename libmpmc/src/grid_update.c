@@ -109,7 +109,7 @@ static void mirror_ghosts(mpmc_sim sim, int fold) {
 }
 
 /** Phase 2 of the step. */
-int mpmc_grid_update(mpmc_sim sim, double dt) {
+int MPMC_ISA(mpmc_grid_update)(mpmc_sim sim, double dt) {
   if (sim->walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim));
   if (sim->nmirror) {
     grow_box_for_mirrors(sim);

@@ -233,20 +233,38 @@ struct mpmc_sim_s {
   struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
   struct mpmc_sets_s *node_sets; /* named grid node sets (sets.c)                     */
   mpmc_monitor monitor;         /* energy check after each step (monitor.c)           */
+  int kernels;                  /* kernel set in use: MPMC_KERNELS_BASELINE or _AVX2   */
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),
  * so two slabs of the same parity, one slab apart, share no node when the slab between them
  * is wider than 2 cells (slabs are widened beyond this to balance the points per thread). */
 #define MPMC_SLAB_W 3
-int mpmc_slabs_build(struct mpmc_sim_s *sim);
 
-/* phases of one step (step.c calls them in this order) */
-int mpmc_p2g(struct mpmc_sim_s *sim, double dt);
-int mpmc_grid_update(struct mpmc_sim_s *sim, double dt);
-int mpmc_g2p(struct mpmc_sim_s *sim, double dt);
-int mpmc_fbar(struct mpmc_sim_s *sim);
+/* The step's kernel phases (p2g.c, grid_update.c, g2p.c, fbar.c) exist once per instruction
+ * set: CMakeLists.txt compiles these four files a second time for x86-64-v3 (AVX2) with
+ * MPMC_ISA_AVX2 defined, which appends _avx2 to their external names.  A sim runs one set
+ * (sim->kernels, mpmc_sim_set_kernels); the results are the same bits, as no floating-point
+ * contraction is allowed in ISO C mode (tests/t303). */
+#ifdef MPMC_ISA_AVX2
+#define MPMC_ISA(fn) fn##_avx2
+#else
+#define MPMC_ISA(fn) fn
+#endif
+#define MPMC_KERNEL_PROTOTYPES(S)                              \
+  int mpmc_slabs_build##S(struct mpmc_sim_s *sim);             \
+  int mpmc_p2g##S(struct mpmc_sim_s *sim, double dt);          \
+  int mpmc_grid_update##S(struct mpmc_sim_s *sim, double dt);  \
+  int mpmc_g2p##S(struct mpmc_sim_s *sim, double dt);          \
+  int mpmc_fbar##S(struct mpmc_sim_s *sim);
+/* phases of one step (step.c calls them in this order, mpmc_stress_update last) */
+MPMC_KERNEL_PROTOTYPES()
+#ifdef MPMC_HAVE_AVX2_KERNELS
+MPMC_KERNEL_PROTOTYPES(_avx2)
+#endif
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
+/* 1 if this build carries the AVX2 kernels and the processor (and OS) runs them (sim.c) */
+int mpmc_kernels_avx2_available(void);
 
 /* helpers shared between files */
 int mpmc_sim_prepare(struct mpmc_sim_s *sim);

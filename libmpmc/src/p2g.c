@@ -21,7 +21,7 @@
  * each thread gets the same share of each colour (fixed-width slabs left one of two threads
  * idle for a third of P2G in the 3D column).  Results depend on the thread count only
  * through the summation order at the nodes that two slabs share. */
-int mpmc_slabs_build(mpmc_sim sim) {
+int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim, n = p->n;
@@ -208,10 +208,10 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS, 
 MPMC_KERNELS(P2G_KERNEL)
 
 /** Phase 1 of the step: reset the grid and scatter the points onto it. */
-int mpmc_p2g(mpmc_sim sim, double dt) {
+int MPMC_ISA(mpmc_p2g)(mpmc_sim sim, double dt) {
   (void)dt;
   mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
-  MPMC_CALL(mpmc_slabs_build(sim));    /* ... and this step's box */
+  MPMC_CALL(MPMC_ISA(mpmc_slabs_build)(sim));    /* ... and this step's box */
   MPMC_KERNEL_CALL(p2g_, sim, sim);
   return MPMC_SUCCESS;
 }

@@ -9,6 +9,54 @@
 #include "mpmc_impl.h"
 #include "sets.h"
 
+int mpmc_kernels_avx2_available(void) {
+#if defined(MPMC_HAVE_AVX2_KERNELS)
+  /* x86-64-v3 is AVX2, BMI1/2, FMA, F16C, LZCNT, MOVBE; the kernels' code uses AVX2 (and the
+   * OS must save the AVX state, which the "avx" check includes) */
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx") && __builtin_cpu_supports("avx2") &&
+         __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+         __builtin_cpu_supports("bmi2");
+#else
+  return 0;
+#endif
+}
+
+/* Why AVX2 kernels cannot run here (for the messages). */
+static const char *avx2_missing(void) {
+#if defined(MPMC_HAVE_AVX2_KERNELS)
+  return "this processor has no AVX2 (x86-64-v3)";
+#else
+  return "this build has no AVX2 kernels (not x86-64, or MPMC_ARCH set)";
+#endif
+}
+
+/* The kernel set of a request: AUTO becomes AVX2 where available, else BASELINE. */
+static int resolve_kernels(int request) {
+  if (request == MPMC_KERNELS_BASELINE) return MPMC_KERNELS_BASELINE;
+  return mpmc_kernels_avx2_available() ? MPMC_KERNELS_AVX2 : MPMC_KERNELS_BASELINE;
+}
+
+/* The default set, or the one MPMC_KERNELS names (auto, baseline, avx2). */
+static int kernels_from_env(mpmc_sim s) {
+  const char *e = getenv("MPMC_KERNELS");
+  int req = MPMC_KERNELS_AUTO;
+  if (e && *e) {
+    if (!strcmp(e, "baseline"))
+      req = MPMC_KERNELS_BASELINE;
+    else if (!strcmp(e, "avx2"))
+      req = MPMC_KERNELS_AVX2;
+    else
+      MPMC_CHECK(!strcmp(e, "auto"), s->ctx, MPMC_ERR_ARG,
+                 "environment variable MPMC_KERNELS = '%.40s' is not one of auto, baseline, avx2",
+                 e);
+  }
+  MPMC_CHECK(req != MPMC_KERNELS_AVX2 || mpmc_kernels_avx2_available(), s->ctx, MPMC_ERR_ARG,
+             "environment variable MPMC_KERNELS = avx2: %s", avx2_missing());
+  s->kernels = resolve_kernels(req);
+  return MPMC_SUCCESS;
+}
+
 /**
  * @brief Create a simulation in dim = 2 (plane strain) or 3 dimensions.
  * Defaults: quadratic B-splines, F-bar off, FLIP/PIC blend 1 (pure FLIP, paper eq 13),
@@ -25,6 +73,11 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
   s->flip = 1.0;
   s->solver = MPMC_SOLVER_AUTO;
   s->p.dim = dim;
+  const int err = kernels_from_env(s);
+  if (err) {
+    free(s);
+    return err;
+  }
   *sim = s;
   return MPMC_SUCCESS;
 }
@@ -162,6 +215,31 @@ int mpmc_sim_set_threads(mpmc_sim sim, int nthreads) {
   MPMC_CHECK(nthreads >= 0 && nthreads <= 1024, sim->ctx, MPMC_ERR_ARG,
              "threads = %d must be in [0, 1024]", nthreads);
   sim->nthreads = nthreads;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Instruction set of the step's transfer kernels (mpmc_kernels).  The sets give the
+ * same results to the bit; AUTO (the default) takes AVX2 where the processor has it.
+ * @param kernels MPMC_KERNELS_AUTO, _BASELINE, or _AVX2 (MPMC_ERR_ARG where this build or
+ *        processor has no AVX2 kernels)
+ */
+int mpmc_sim_set_kernels(mpmc_sim sim, int kernels) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_AVX2, sim->ctx,
+             MPMC_ERR_ARG, "kernels = %d is not one of auto (0), baseline (1), avx2 (2)",
+             kernels);
+  MPMC_CHECK(kernels != MPMC_KERNELS_AVX2 || mpmc_kernels_avx2_available(), sim->ctx,
+             MPMC_ERR_ARG, "kernels = avx2 (2): %s", avx2_missing());
+  sim->kernels = resolve_kernels(kernels);
+  return MPMC_SUCCESS;
+}
+
+/** @brief The kernel set the step runs: MPMC_KERNELS_BASELINE or MPMC_KERNELS_AVX2. */
+int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(kernels, sim->ctx, MPMC_ERR_ARG, "kernels pointer is NULL");
+  *kernels = sim->kernels;
   return MPMC_SUCCESS;
 }
 

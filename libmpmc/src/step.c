@@ -13,12 +13,29 @@ static double now(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* The kernel phases for each instruction set (mpmc_impl.h, mpmc_sim_set_kernels). */
+typedef struct {
+  int (*p2g)(mpmc_sim, double);
+  int (*grid_update)(mpmc_sim, double);
+  int (*g2p)(mpmc_sim, double);
+  int (*fbar)(mpmc_sim);
+} kernel_set;
+static const kernel_set baseline = {mpmc_p2g, mpmc_grid_update, mpmc_g2p, mpmc_fbar};
+#ifdef MPMC_HAVE_AVX2_KERNELS
+static const kernel_set avx2 = {mpmc_p2g_avx2, mpmc_grid_update_avx2, mpmc_g2p_avx2,
+                                mpmc_fbar_avx2};
+#define KERNELS(sim) ((sim)->kernels == MPMC_KERNELS_AVX2 ? &avx2 : &baseline)
+#else
+#define KERNELS(sim) (&baseline)
+#endif
+
 static int step_phases(mpmc_sim sim, double dt) {
+  const kernel_set *k = KERNELS(sim);
   if (sim->bodies) MPMC_CALL(mpmc_contact_update(sim, dt)); /* barrier forces on points */
-  MPMC_CALL(mpmc_p2g(sim, dt));          /* mass, momentum, forces      (eqs 7, 8, 10) */
-  MPMC_CALL(mpmc_grid_update(sim, dt));  /* velocities, walls, damping  (eq 9)         */
-  MPMC_CALL(mpmc_g2p(sim, dt));          /* v, dF, J, x                 (eqs 13-17)    */
-  if (sim->fbar) MPMC_CALL(mpmc_fbar(sim)); /* dF -> dF-bar             (Alg. 1, 2-4)  */
+  MPMC_CALL(k->p2g(sim, dt));            /* mass, momentum, forces      (eqs 7, 8, 10) */
+  MPMC_CALL(k->grid_update(sim, dt));    /* velocities, walls, damping  (eq 9)         */
+  MPMC_CALL(k->g2p(sim, dt));            /* v, dF, J, x                 (eqs 13-17)    */
+  if (sim->fbar) MPMC_CALL(k->fbar(sim)); /* dF -> dF-bar               (Alg. 1, 2-4)  */
   MPMC_CALL(mpmc_stress_update(sim, dt)); /* material update with dF(-bar)             */
   if (sim->bodies) MPMC_CALL(mpmc_contact_check(sim)); /* no point inside a rigid body */
   MPMC_CALL(mpmc_monitor_step(sim)); /* NaN velocity, energy growth (monitor.c)         */

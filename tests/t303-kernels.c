@@ -1,0 +1,165 @@
+/* The AVX2 kernels give the baseline kernels' results to the bit (mpmc_sim_set_kernels):
+ * the same scene stepped once with each set, on the same number of threads, every particle
+ * field compared with memcmp.  The scenes cover both dimensions, all four bases, F-bar off,
+ * Algorithm 1 and the total form, elastic, plastic and rigid-body contact forces, damping and
+ * walls (mirrored ghosts).  Also the set/get calls and the MPMC_KERNELS variable. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "mpmc_impl.h"
+#include "test_util.h"
+
+typedef struct {
+  int dim, basis, fbar, material, rigid;
+  double damping;
+} scene;
+
+enum { ELASTIC, PLASTIC };
+
+/* Build the scene, step it with the given kernel set, return the context and sim. */
+static void run(const scene *sc, int kernels, mpmc_context *pctx, mpmc_sim *psim) {
+  mpmc_context ctx;
+  mpmc_sim sim;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  TCALL(mpmc_sim_create(ctx, sc->dim, &sim));
+  TCALL(mpmc_sim_set_kernels(sim, kernels));
+  int got;
+  TCALL(mpmc_sim_get_kernels(sim, &got));
+  assert_int_equal(got, kernels);
+  const double h = sc->dim == 2 ? 0.05 : 0.1;
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1.5, 1};
+  const double blo[3] = {0, 0, 0}, bhi[3] = {1.2, 0.8, 0.6};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  TCALL(mpmc_sim_set_basis(sim, sc->basis));
+  TCALL(mpmc_sim_set_fbar(sim, sc->fbar));
+  TCALL(mpmc_sim_set_damping(sim, sc->damping));
+  TCALL(mpmc_sim_set_flip_blend(sim, 0.95));
+  int mat;
+  if (sc->material == PLASTIC)
+    TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e6, 0.49, 2000, 6e3, 1e3, 20, &mat));
+  else
+    TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e6, 0.45, 2000, &mat));
+  TCALL(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, NULL));
+  for (int f = 0; f < 2 * sc->dim; ++f)
+    if (f != 1 && f != 3) TCALL(mpmc_sim_add_wall_face(sim, f, f == 2 ? MPMC_WALL_FIXED : MPMC_WALL_SLIP, NULL));
+  const double g[3] = {0, -9.81, 0};
+  TCALL(mpmc_sim_set_gravity(sim, g));
+  if (sc->rigid) { /* a plate pressed onto the block's top */
+    const double plo[3] = {0.2, 0.8, 0.2}, phi[3] = {0.6, 1.0, 0.4}, pv[3] = {0, -0.5, 0};
+    int body;
+    TCALL(mpmc_sim_add_rigid_box(sim, plo, phi, 0.5, &body));
+    TCALL(mpmc_sim_set_rigid_velocity(sim, body, pv));
+  }
+  /* a shear velocity field, so that every point moves and the plastic points yield */
+  double *x, *v;
+  int nc;
+  TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, &nc));
+  TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, &nc));
+  int n;
+  TCALL(mpmc_sim_get_num_particles(sim, &n));
+  for (int q = 0; q < n; ++q) v[(size_t)q * sc->dim] = 0.8 * x[(size_t)q * sc->dim + 1];
+  double dt;
+  TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
+  for (int s = 0; s < 30; ++s) TCALL(mpmc_sim_step(sim, dt));
+  *pctx = ctx;
+  *psim = sim;
+}
+
+static void check_scene(const scene *sc) {
+  mpmc_context c0, c1;
+  mpmc_sim s0, s1;
+  run(sc, MPMC_KERNELS_BASELINE, &c0, &s0);
+  run(sc, MPMC_KERNELS_AVX2, &c1, &s1);
+  int n;
+  TCALL(mpmc_sim_get_num_particles(s0, &n));
+  int compared = 0;
+  for (int f = 0; f < MPMC_FIELD_COUNT; ++f) {
+    double *a, *b;
+    int na, nb;
+    if (mpmc_sim_get_field(s0, f, &a, &na) || !a) continue; /* a field this scene has not */
+    TCALL(mpmc_sim_get_field(s1, f, &b, &nb));
+    assert_int_equal(na, nb);
+    if (memcmp(a, b, sizeof(double) * (size_t)n * (size_t)na)) {
+      for (size_t i = 0; i < (size_t)n * (size_t)na; ++i)
+        if (memcmp(&a[i], &b[i], sizeof(double)))
+          fail_msg("dim %d basis %d fbar %d: field %d, entry %zu: baseline %.17g, avx2 %.17g",
+                   sc->dim, sc->basis, sc->fbar, f, i, a[i], b[i]);
+    }
+    ++compared;
+  }
+  if (compared < 5) fail_msg("only %d fields compared", compared);
+  mpmc_sim_destroy(&s0);
+  mpmc_sim_destroy(&s1);
+  mpmc_context_destroy(&c0);
+  mpmc_context_destroy(&c1);
+}
+
+static void same_bits(void **state) {
+  (void)state;
+  if (!mpmc_kernels_avx2_available()) skip(); /* no AVX2 kernels in this build or CPU */
+  const scene scenes[] = {
+      {3, MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, PLASTIC, 0, 0.0},
+      {3, MPMC_BASIS_LINEAR, MPMC_FBAR_OFF, ELASTIC, 1, 0.05},
+      {3, MPMC_BASIS_UGIMP, MPMC_FBAR_TOTAL, PLASTIC, 0, 0.0},
+      {3, MPMC_BASIS_BSPLINE3, MPMC_FBAR_PAPER, ELASTIC, 0, 0.1},
+      {2, MPMC_BASIS_UGIMP, MPMC_FBAR_TOTAL, PLASTIC, 1, 0.1},
+      {2, MPMC_BASIS_BSPLINE2, MPMC_FBAR_OFF, ELASTIC, 0, 0.0},
+      {2, MPMC_BASIS_LINEAR, MPMC_FBAR_PAPER, PLASTIC, 0, 0.0},
+      {2, MPMC_BASIS_BSPLINE3, MPMC_FBAR_TOTAL, ELASTIC, 1, 0.02},
+  };
+  for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; ++k) check_scene(&scenes[k]);
+}
+
+static void set_get(void **state) {
+  (void)state;
+  mpmc_context ctx;
+  mpmc_sim sim;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  TCALL(mpmc_sim_create(ctx, 2, &sim));
+  int k = -1;
+  TCALL(mpmc_sim_get_kernels(sim, &k));
+  assert_int_equal(k, mpmc_kernels_avx2_available() ? MPMC_KERNELS_AVX2 : MPMC_KERNELS_BASELINE);
+  TCALL(mpmc_sim_set_kernels(sim, MPMC_KERNELS_BASELINE));
+  TCALL(mpmc_sim_get_kernels(sim, &k));
+  assert_int_equal(k, MPMC_KERNELS_BASELINE);
+  TCALL(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AUTO)); /* AUTO resolves to a set */
+  TCALL(mpmc_sim_get_kernels(sim, &k));
+  assert_true(k == MPMC_KERNELS_BASELINE || k == MPMC_KERNELS_AVX2);
+  assert_int_equal(mpmc_sim_set_kernels(sim, 3), MPMC_ERR_ARG);
+  assert_non_null(strstr(mpmc_context_last_error(ctx), "kernels = 3"));
+  assert_int_equal(mpmc_sim_get_kernels(sim, NULL), MPMC_ERR_ARG);
+  if (!mpmc_kernels_avx2_available()) {
+    assert_int_equal(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AVX2), MPMC_ERR_ARG);
+    assert_non_null(strstr(mpmc_context_last_error(ctx), "no AVX2"));
+  }
+  mpmc_sim_destroy(&sim);
+  /* the environment variable: a valid name sets the default, anything else is an error
+   * naming the variable, and no sim is made */
+  setenv("MPMC_KERNELS", "baseline", 1);
+  TCALL(mpmc_sim_create(ctx, 3, &sim));
+  TCALL(mpmc_sim_get_kernels(sim, &k));
+  assert_int_equal(k, MPMC_KERNELS_BASELINE);
+  mpmc_sim_destroy(&sim);
+  setenv("MPMC_KERNELS", "sse9", 1);
+  sim = NULL;
+  assert_int_equal(mpmc_sim_create(ctx, 3, &sim), MPMC_ERR_ARG);
+  assert_null(sim);
+  assert_non_null(strstr(mpmc_context_last_error(ctx), "MPMC_KERNELS = 'sse9'"));
+  unsetenv("MPMC_KERNELS");
+  mpmc_context_destroy(&ctx);
+}
+
+int main(void) {
+  unsetenv("MPMC_KERNELS");
+  const struct CMUnitTest tests[] = {
+      cmocka_unit_test(same_bits),
+      cmocka_unit_test(set_get),
+  };
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
