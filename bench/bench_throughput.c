@@ -3,7 +3,7 @@
  *   column - the 3D column collapse of issue 6: 2 x 0.5 x 1 m domain, h = 0.025 m, a 0.5 m
  *            cube of J2 soil with 2x2x2 points per cell (64,000 points), gravity
  * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale] [case] [threads] [shuffle];
- * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-4,
+ * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-6,
  * the rows of the table; -1 all) and threads (1 or 2; 0 both) narrow the run for profiling,
  * e.g. under callgrind; shuffle = 1 stores the points in random order (what sorting the
  * particle arrays by cell would undo: the cost of lost locality).  With MPMC_BENCH_CPU set in
@@ -131,6 +131,8 @@ int main(int argc, char **argv) {
       {0, MPMC_BASIS_BSPLINE2, 0, 0}, {0, MPMC_BASIS_BSPLINE2, 1, 0},
       {1, MPMC_BASIS_LINEAR, 0, 1},   {1, MPMC_BASIS_BSPLINE2, 0, 1},
       {1, MPMC_BASIS_BSPLINE2, 1, 1},
+      /* the landslide's basis (slope_3d.yaml) */
+      {1, MPMC_BASIS_UGIMP, 0, 1},    {1, MPMC_BASIS_UGIMP, 1, 1},
   };
   printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s %7s\n", "scene", "basis", "fbar", "material",
          "points", "1 thread [M/s]", "2 threads [M/s]", "speedup", "B/point");
