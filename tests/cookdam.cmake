@@ -15,3 +15,18 @@ if(MPMC_BASH AND MPMC_WITH_GMSH)
   set_tests_properties(t661-error-vs-runtime-small PROPERTIES LABELS workflow TIMEOUT 300
     ENVIRONMENT "OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
 endif()
+# --report redraws the table and PNG from the CSV as it stands: a row appended to the small
+# sweep's Cook CSV (as when runs made elsewhere are merged) must appear in the table
+if(MPMC_BASH AND MPMC_WITH_GMSH)
+  set_tests_properties(t661-error-vs-runtime-small PROPERTIES FIXTURES_SETUP evr_small)
+  set(_evr ${CMAKE_CURRENT_BINARY_DIR}/evr-small)
+  add_test(NAME t662-error-vs-runtime-report
+    COMMAND ${MPMC_BASH} -c "set -e; d=${_evr}/report; rm -rf \"$d\"; mkdir -p \"$d\"; \
+cp ${_evr}/evr_cook.csv \"$d\"/; \
+echo 'cook,ugimp_total_h0.125,ugimp,total,0.125,completed,quasi_static,368000,900000,5000,0.2762,0.2765,0.0010850,4999.5' >> \"$d\"/evr_cook.csv; \
+${PROJECT_SOURCE_DIR}/bench/error_vs_runtime --report --bench cook --figures \"$d\" --out \"$d\"/out; \
+grep -q '| ugimp | total | 0.125 | 368000 | 900000 | 4999.5 | 5000.0 | 0.2762 | 0.11 % |' \"$d\"/evr_cook.md; \
+test $(grep -c '^| ugimp' \"$d\"/evr_cook.md) -eq 5; \
+if command -v gnuplot >/dev/null; then test -s \"$d\"/evr_cook.png; fi")
+  set_tests_properties(t662-error-vs-runtime-report PROPERTIES LABELS workflow FIXTURES_REQUIRED evr_small)
+endif()
