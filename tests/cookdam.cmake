@@ -13,12 +13,9 @@ if(MPMC_BASH AND MPMC_WITH_GMSH)
     COMMAND ${MPMC_BASH} ${PROJECT_SOURCE_DIR}/bench/error_vs_runtime --small --check --bench cook,dam,footing,landslide
             --mpmc $<TARGET_FILE:mpmc_cli> --out ${CMAKE_CURRENT_BINARY_DIR}/evr-small)
   set_tests_properties(t661-error-vs-runtime-small PROPERTIES LABELS workflow TIMEOUT 600
-    ENVIRONMENT "OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
-endif()
-# --report redraws the table and PNG from the CSV as it stands: a row appended to the small
-# sweep's Cook CSV (as when runs made elsewhere are merged) must appear in the table
-if(MPMC_BASH AND MPMC_WITH_GMSH)
-  set_tests_properties(t661-error-vs-runtime-small PROPERTIES FIXTURES_SETUP evr_small)
+    ENVIRONMENT "OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1" FIXTURES_SETUP evr_small)
+  # --report redraws the table and PNG from the CSV as it stands: a row appended to the
+  # small sweep's Cook CSV (as when runs made elsewhere are merged) must appear in the table
   set(_evr ${CMAKE_CURRENT_BINARY_DIR}/evr-small)
   add_test(NAME t662-error-vs-runtime-report
     COMMAND ${MPMC_BASH} -c "set -e; d=${_evr}/report; rm -rf \"$d\"; mkdir -p \"$d\"; \

@@ -32,10 +32,14 @@ static const char *avx2_missing(void) {
 #endif
 }
 
-/* The kernel set of a request: AUTO becomes AVX2 where available, else BASELINE. */
-static int resolve_kernels(int request) {
-  if (request == MPMC_KERNELS_BASELINE) return MPMC_KERNELS_BASELINE;
-  return mpmc_kernels_avx2_available() ? MPMC_KERNELS_AVX2 : MPMC_KERNELS_BASELINE;
+/* Take a valid request (mpmc_kernels): AVX2 is refused where it cannot run, the message
+ * naming the request as `what` says; AUTO becomes AVX2 where available, else BASELINE. */
+static int use_kernels(mpmc_sim s, int request, const char *what) {
+  const int avx2 = mpmc_kernels_avx2_available();
+  MPMC_CHECK(request != MPMC_KERNELS_AVX2 || avx2, s->ctx, MPMC_ERR_ARG, "%s: %s", what,
+             avx2_missing());
+  s->kernels = request != MPMC_KERNELS_BASELINE && avx2 ? MPMC_KERNELS_AVX2 : MPMC_KERNELS_BASELINE;
+  return MPMC_SUCCESS;
 }
 
 /* The default set, or the one MPMC_KERNELS names (auto, baseline, avx2). */
@@ -52,10 +56,7 @@ static int kernels_from_env(mpmc_sim s) {
                  "environment variable MPMC_KERNELS = '%.40s' is not one of auto, baseline, avx2",
                  e);
   }
-  MPMC_CHECK(req != MPMC_KERNELS_AVX2 || mpmc_kernels_avx2_available(), s->ctx, MPMC_ERR_ARG,
-             "environment variable MPMC_KERNELS = avx2: %s", avx2_missing());
-  s->kernels = resolve_kernels(req);
-  return MPMC_SUCCESS;
+  return use_kernels(s, req, "environment variable MPMC_KERNELS = avx2");
 }
 
 /**
@@ -230,10 +231,7 @@ int mpmc_sim_set_kernels(mpmc_sim sim, int kernels) {
   MPMC_CHECK(kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_AVX2, sim->ctx,
              MPMC_ERR_ARG, "kernels = %d is not one of auto (0), baseline (1), avx2 (2)",
              kernels);
-  MPMC_CHECK(kernels != MPMC_KERNELS_AVX2 || mpmc_kernels_avx2_available(), sim->ctx,
-             MPMC_ERR_ARG, "kernels = avx2 (2): %s", avx2_missing());
-  sim->kernels = resolve_kernels(kernels);
-  return MPMC_SUCCESS;
+  return use_kernels(sim, kernels, "kernels = avx2 (2)");
 }
 
 /** @brief The kernel set the step runs: MPMC_KERNELS_BASELINE or MPMC_KERNELS_AVX2. */
