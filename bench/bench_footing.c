@@ -4,7 +4,8 @@
  *     n=20          cells per footing width B (h = B/n)
  *     size=12       soil width and depth in B (half model: x in [0, size B], y in [0, size B])
  *     basis=bspline2  ugimp | bspline2 | bspline3 | linear
- *     fbar=2        2: F-bar, projection of det F (total); 1: F-bar, Algorithm 1 (paper); 0: standard
+ *     fbar=3        3: F-bar, stable form (det F projected one order below the basis); 2: F-bar,
+ *                   projection of det F (total); 1: F-bar, Algorithm 1 (paper); 0: standard
  *     rate=0.0025   footing velocity in B per second (after a ramp over the first ramp B)
  *     ramp=0.001    settlement over which the velocity ramps up linearly [B]
  *     delta=0.006   final settlement [B]
@@ -161,7 +162,7 @@ static int run(const opts *o) {
 }
 
 int main(int argc, char **argv) {
-  opts o = {.n = 20, .basis = MPMC_BASIS_BSPLINE2, .fbar = MPMC_FBAR_TOTAL, .threads = 0, .size = 12, .rate = 0.0025,
+  opts o = {.n = 20, .basis = MPMC_BASIS_BSPLINE2, .fbar = MPMC_FBAR_STABLE, .threads = 0, .size = 12, .rate = 0.0025,
             .ramp = 0.001, .delta = 0.006, .damping = 0.002, .cfl = 0.4, .flip = 1.0, .mu = 1000,
             .dhat = 0.0, .kappa = 0.0, .csv = NULL};
   for (int i = 1; i < argc; ++i) {

@@ -3,7 +3,7 @@
  *   column - the 3D column collapse of issue 6: 2 x 0.5 x 1 m domain, h = 0.025 m, a 0.5 m
  *            cube of J2 soil with 2x2x2 points per cell (64,000 points), gravity
  * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale] [case] [threads] [shuffle];
- * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-6,
+ * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-8,
  * the rows of the table; -1 all) and threads (1 or 2; 0 both) narrow the run for profiling,
  * e.g. under callgrind; shuffle = 1 stores the points in random order (what sorting the
  * particle arrays by cell would undo: the cost of lost locality).  With MPMC_BENCH_CPU set in
@@ -124,7 +124,7 @@ int main(int argc, char **argv) {
   shuffle_points = argc > 5 ? atoi(argv[5]) : 0;
   use_cpu_time = getenv("MPMC_BENCH_CPU") != NULL;
   const char *bn[4] = {"linear", "ugimp", "bspline2", "bspline3"};
-  const char *fb[3] = {"off", "paper", "total"};
+  const char *fb[4] = {"off", "paper", "total", "stable"};
   struct {
     int scene, basis, fbar, j2;
   } cases[] = {
@@ -133,6 +133,8 @@ int main(int argc, char **argv) {
       {1, MPMC_BASIS_BSPLINE2, 1, 1},
       /* the landslide's basis (slope_3d.yaml) */
       {1, MPMC_BASIS_UGIMP, 0, 1},    {1, MPMC_BASIS_UGIMP, 1, 1},
+      /* the stable form of F-bar (J-bar one order below the basis) */
+      {1, MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, 1}, {1, MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, 1},
   };
   printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s %7s\n", "scene", "basis", "fbar", "material",
          "points", "1 thread [M/s]", "2 threads [M/s]", "speedup", "B/point");

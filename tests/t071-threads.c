@@ -88,8 +88,14 @@ static void test_3d_fbar(void **state) {
   check(3, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2);
 }
 
+/* the stable form scatters onto the 2h grid: supports one node wider than the basis' */
+static void test_3d_ugimp_stable(void **state) {
+  (void)state;
+  check(3, MPMC_FBAR_STABLE, MPMC_BASIS_UGIMP);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_2d_fbar), cmocka_unit_test(test_2d_ugimp_total),
-                                     cmocka_unit_test(test_3d_fbar)};
+                                     cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,7 +1,7 @@
 /* The AVX2 kernels give the baseline kernels' results to the bit (mpmc_sim_set_kernels):
  * the same scene stepped once with each set, on the same number of threads, every particle
  * field compared with memcmp.  The scenes cover both dimensions, all four bases, F-bar off,
- * Algorithm 1 and the total form, elastic, plastic and rigid-body contact forces, damping and
+ * Algorithm 1, the total and the stable form, elastic, plastic and rigid-body contact forces, damping and
  * walls (mirrored ghosts).  Also the set/get calls and the MPMC_KERNELS variable. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -111,6 +111,9 @@ static void same_bits(void **state) {
       {2, MPMC_BASIS_BSPLINE2, MPMC_FBAR_OFF, ELASTIC, 0, 0.0},
       {2, MPMC_BASIS_LINEAR, MPMC_FBAR_PAPER, PLASTIC, 0, 0.0},
       {2, MPMC_BASIS_BSPLINE3, MPMC_FBAR_TOTAL, ELASTIC, 1, 0.02},
+      {2, MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, PLASTIC, 1, 0.0},
+      {3, MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, PLASTIC, 0, 0.05},
+      {3, MPMC_BASIS_BSPLINE3, MPMC_FBAR_STABLE, ELASTIC, 1, 0.0},
   };
   for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; ++k) check_scene(&scenes[k]);
 }

@@ -151,6 +151,7 @@ program t421_user_hencky_f
   call compare(2, 0)
   call compare(2, 1)
   call compare(3, 1)
+  call compare(2, int(MPMC_FBAR_STABLE))
   call failing()
   if (nfail > 0) error stop 1
 

@@ -25,8 +25,11 @@
 
 #include "test_util.h"
 
-/* mean q/su over settlements [0.002, 0.003) B (w[0]) and [0.003, 0.004] B (w[1]) */
-static void footing_windows(int basis, int fbar, double w[2]) {
+/* mean q/su over settlements [0.002, 0.003) B (w[0]) and [0.003, 0.004] B (w[1]); w[2]: the
+ * checkerboard of the pressure under the footing at the end, the RMS over the points of the
+ * six rows below the two under the contact (away from the ends) of p minus the mean of its
+ * four lattice neighbours, over the mean p */
+static void footing_windows(int basis, int fbar, double w[3]) {
   const double B = 1.0, E = 1.0e6, nu = 0.49, su = 100.0, rho = 1000.0, size = 3.0;
   const double h = B / 10, W = size * B, D = size * B, rate = 0.0025 * B, ramp = 0.001 * B;
   const double delta_end = 0.004 * B;
@@ -77,6 +80,32 @@ static void footing_windows(int basis, int fbar, double w[2]) {
       nq[k]++;
     }
   }
+  {
+    const double dx = 0.5 * h;
+    const int nx = (int)lround(W / dx), ny = (int)lround(D / dx);
+    double *pg = calloc((size_t)nx * ny, sizeof(double)), *x0, *st;
+    int nc;
+    TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, &nc));
+    TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &st, &nc));
+    for (int q = 0; q < n; ++q) {
+      const int i = (int)(x0[2 * q] / dx), j = (int)(x0[2 * q + 1] / dx);
+      pg[(size_t)j * nx + i] = -(st[6 * q] + st[6 * q + 1] + st[6 * q + 2]) / 3.0;
+    }
+    TCALL(mpmc_sim_restore_field(sim, MPMC_FIELD_STRESS, &st));
+    TCALL(mpmc_sim_restore_field(sim, MPMC_FIELD_X0, &x0));
+    double sd = 0.0, sp = 0.0;
+    int m = 0;
+    const int nfoot = (int)lround(0.5 * B / dx);
+    for (int j = ny - 8; j < ny - 2; ++j)
+      for (int i = 1; i < nfoot - 1; ++i, ++m) {
+        const double *c = pg + (size_t)j * nx + i;
+        const double d = c[0] - 0.25 * (c[-1] + c[1] + c[-nx] + c[nx]);
+        sd += d * d;
+        sp += c[0];
+      }
+    w[2] = sqrt(sd / m) / (sp / m);
+    free(pg);
+  }
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;
@@ -87,7 +116,7 @@ static void footing_windows(int basis, int fbar, double w[2]) {
 static void test_fbar_and_standard(void **state) {
   (void)state;
   const double want = 2.0 + M_PI;
-  double f[2], s[2];
+  double f[3], s[3];
   footing_windows(MPMC_BASIS_BSPLINE2, MPMC_FBAR_TOTAL, f);
   const double rf = 0.5 * (f[0] + f[1]);
   if (fabs(f[1] - f[0]) > 0.01 * rf)
@@ -105,9 +134,37 @@ static void test_fbar_and_standard(void **state) {
              s[0], s[1], rs, rf);
 }
 
+/* The stable form (J-bar one order below the basis): no checkerboard of the pressure under
+ * the footing (the total form's, projected onto the basis itself, alternates by a large
+ * share of the mean from node to node), a level curve and a ratio closer to 2 + pi. */
+static void test_stable(void **state) {
+  (void)state;
+  const double want = 2.0 + M_PI;
+  const int bases[2] = {MPMC_BASIS_UGIMP, MPMC_BASIS_BSPLINE2};
+  for (int k = 0; k < 2; ++k) {
+    double t[3], f[3];
+    footing_windows(bases[k], MPMC_FBAR_TOTAL, t);
+    footing_windows(bases[k], MPMC_FBAR_STABLE, f);
+    const double rt = 0.5 * (t[0] + t[1]), rf = 0.5 * (f[0] + f[1]);
+    print_message("basis %d: total %.4f (%+.1f %%, checkerboard %.3f), stable %.4f (%+.1f %%, "
+                  "checkerboard %.3f)\n", bases[k], rt, 100 * (rt / want - 1), t[2], rf,
+                  100 * (rf / want - 1), f[2]);
+    if (fabs(f[1] - f[0]) > 0.01 * rf)
+      fail_msg("stable, basis %d: q/su %.4f then %.4f, expected a level curve (within 1 %%)",
+               bases[k], f[0], f[1]);
+    if (!(f[2] < 0.1) || !(t[2] > 3 * f[2]))
+      fail_msg("basis %d: pressure checkerboard %.3f (stable) against %.3f (total), expected "
+               "below 0.1 and under a third of the total form's", bases[k], f[2], t[2]);
+    if (!(rf < rt) || fabs(rf - want) > 0.12 * want)
+      fail_msg("stable, basis %d: bearing_capacity_ratio %.4f, expected below the total form's "
+               "%.4f and within 12 %% of 2 + pi = %.4f", bases[k], rf, rt, want);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_fbar_and_standard),
+      cmocka_unit_test(test_stable),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -153,6 +153,13 @@ static void test_bad_override(void **state) {
   if (e == 0) fail_msg("--set grid.cell_sise=1: expected a failure, got 0");
   expect_in("--set typo", msg, "key 'grid.cell_sise': unknown key (did you mean 'cell_size'?)");
   if (exists(DIR "/out-override")) fail_msg("a failed --set created the output directory");
+  const char *fb[] = {"fbar=stabel"};
+  e = run_lib(scene, DIR "/out-override", 1, fb, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set fbar=stabel: expected a failure, got 0");
+  expect_in("--set fbar", msg, "key 'fbar': expected true, false, paper, total or stable (got 'stabel')");
+  const char *ok[] = {"fbar=stable", "stages.0.end.time=0.0005"};
+  e = run_lib(scene, DIR "/out-fbar-stable", 2, ok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e != 0) fail_msg("--set fbar=stable: expected success, got %d: %s", e, msg);
 }
 
 static void test_existing_output(void **state) {

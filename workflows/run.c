@@ -581,7 +581,10 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
     fputs(",\n", f);
   }
   fprintf(f, "  \"dim\": %d,\n  \"basis\": \"%s\",\n  \"fbar\": %s,\n  \"cell_size\": %.9g,\n", w->sc.dim,
-          wf_basis_name(w->sc.basis), w->sc.fbar == MPMC_FBAR_TOTAL ? "\"total\"" : w->sc.fbar ? "true" : "false", w->sc.h);
+          wf_basis_name(w->sc.basis), w->sc.fbar == MPMC_FBAR_TOTAL    ? "\"total\""
+          : w->sc.fbar == MPMC_FBAR_STABLE ? "\"stable\""
+          : w->sc.fbar                     ? "true"
+                                           : "false", w->sc.h);
   int kern = MPMC_KERNELS_BASELINE;
   mpmc_sim_get_kernels(w->sim, &kern);
   fprintf(f, "  \"kernels\": \"%s\",\n", kern == MPMC_KERNELS_AVX2 ? "avx2" : "baseline");

@@ -402,19 +402,26 @@ static int get_int(rd *r, const wf_node *map, const char *path, const char *key,
   return 0;
 }
 
+/* 1 or 0 for a YAML boolean word, -1 for anything else */
+static int bool_word(const wf_node *n) {
+  static const char *yes[] = {"true", "yes", "on", "True", "TRUE", NULL};
+  static const char *no[] = {"false", "no", "off", "False", "FALSE", NULL};
+  if (n->kind == WF_SCALAR && !n->quoted) {
+    for (int i = 0; yes[i]; ++i)
+      if (!strcmp(n->value, yes[i])) return 1;
+    for (int i = 0; no[i]; ++i)
+      if (!strcmp(n->value, no[i])) return 0;
+  }
+  return -1;
+}
+
 static int get_bool(rd *r, const wf_node *map, const char *path, const char *key, int def, int *out) {
   char full[512];
   join(full, sizeof full, path, key);
   const wf_node *n = map_get(map, key);
   if (!n) return *out = def, 0;
-  static const char *yes[] = {"true", "yes", "on", "True", "TRUE", NULL};
-  static const char *no[] = {"false", "no", "off", "False", "FALSE", NULL};
-  if (n->kind == WF_SCALAR && !n->quoted) {
-    for (int i = 0; yes[i]; ++i)
-      if (!strcmp(n->value, yes[i])) return *out = 1, 0;
-    for (int i = 0; no[i]; ++i)
-      if (!strcmp(n->value, no[i])) return *out = 0, 0;
-  }
+  const int b = bool_word(n);
+  if (b >= 0) return *out = b, 0;
   return fail_at(r, n, full, "expected true or false (got '%s')", shown(n));
 }
 
@@ -1184,17 +1191,22 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
       return fail_at(r, map_get(g, "cell_size"), "grid.cell_size",
                      "must not exceed the grid's extent %g along axis %d (got %g)", sc->hi[a] - sc->lo[a], a, sc->h);
   if (get_enum(r, root, "", "basis", 0, MPMC_BASIS_BSPLINE2, basis_words, &sc->basis)) return -1;
-  /* fbar: true (= paper, Algorithm 1 as published), false, paper or total */
+  /* fbar: true (= paper, Algorithm 1 as published), false, paper, total or stable */
   {
     const wf_node *fn = map_get(root, "fbar");
-    if (fn && fn->kind == WF_SCALAR && !fn->quoted && !strcmp(fn->value, "paper"))
-      sc->fbar = MPMC_FBAR_PAPER;
-    else if (fn && fn->kind == WF_SCALAR && !fn->quoted && !strcmp(fn->value, "total"))
-      sc->fbar = MPMC_FBAR_TOTAL;
-    else if (get_bool(r, root, "", "fbar", 1, &sc->fbar))
-      return -1;
-    else if (sc->fbar)
-      sc->fbar = MPMC_FBAR_PAPER;
+    static const char *const words[] = {"paper", "total", "stable"};
+    static const int modes[] = {MPMC_FBAR_PAPER, MPMC_FBAR_TOTAL, MPMC_FBAR_STABLE};
+    sc->fbar = -1;
+    if (!fn) sc->fbar = MPMC_FBAR_PAPER;
+    for (int i = 0; i < 3 && fn && fn->kind == WF_SCALAR && !fn->quoted; ++i)
+      if (!strcmp(fn->value, words[i])) sc->fbar = modes[i];
+    if (sc->fbar < 0 && fn) {
+      const int b = bool_word(fn);
+      if (b < 0)
+        return fail_at(r, fn, "fbar", "expected true, false, paper, total or stable (got '%s')",
+                       shown(fn));
+      sc->fbar = b ? MPMC_FBAR_PAPER : MPMC_FBAR_OFF;
+    }
   }
   if (get_num(r, root, "", "flip", 0, 1.0, UNIT, &sc->flip)) return -1;
   if (get_enum(r, root, "", "solver", 0, MPMC_SOLVER_AUTO, solver_words, &sc->solver)) return -1;

@@ -140,6 +140,7 @@ contains
       fbar = -1
       if (val == 'true' .or. val == 'paper') fbar = MPMC_FBAR_PAPER
       if (val == 'total') fbar = MPMC_FBAR_TOTAL
+      if (val == 'stable') fbar = MPMC_FBAR_STABLE
       if (val == 'false') fbar = MPMC_FBAR_OFF
       if (fbar < 0) ios = 1
     case ('stages.gravity.end.max_time')

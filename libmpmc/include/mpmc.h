@@ -66,8 +66,10 @@ typedef enum {
 typedef enum {
   MPMC_FBAR_OFF = 0,   /* the standard formulation                                     */
   MPMC_FBAR_PAPER = 1, /* Algorithm 1 as published: projects Jbar^n dJ (eq 26)         */
-  MPMC_FBAR_TOTAL = 2  /* projects the Jacobian det F (eqs 18-21 in eq 25): no drift in  */
+  MPMC_FBAR_TOTAL = 2, /* projects the Jacobian det F (eqs 18-21 in eq 25): no drift in  */
                        /* long quasi-static runs (docs/theory.md)                       */
+  MPMC_FBAR_STABLE = 3 /* the total form projected onto a space one order below the     */
+                       /* basis: no checkerboard of the pressure (docs/theory.md)       */
 } mpmc_fbar_mode;
 
 typedef enum {

@@ -6,11 +6,17 @@
  * itself, inserted in eq 25).  The paper's recursion re-projects Jbar every step, so in a
  * long quasi-static run the smoothing of a non-uniform Jbar near boundaries accumulates
  * into a creep of the true volume (docs/theory.md); the total form has no such memory.
+ * MPMC_FBAR_STABLE projects det F like the total form, but onto a space one order below
+ * the basis instead of the basis itself (docs/theory.md, "The J-bar space"): linear hats on
+ * the grid of spacing 2h (nodes x = lo, lo + 2h, ...) for linear and uGIMP, linear hats
+ * centred on the cells for quadratic B-splines, quadratic B-splines centred on the cells for
+ * cubic ones.  With w the weights of that space the formulas above are unchanged.
  * V_p is the volume at t^n.  In a step the scatter runs fused into G2P (which has the
- * weights at x^n at hand and sets grid.fb_done); called on its own (tests) the projection
+ * weights at x^n at hand and sets grid.fb_done), except in the stable form, whose weights
+ * G2P does not have; called on its own (tests), or in the stable form, the projection
  * scatters here, recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter
  * leaves Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
- * Touches nothing but dF (handed to the material) and Jbar. */
+ * Touches nothing but dF (handed to the material), Jbar and the grid's fb. */
 #include <math.h>
 #include <string.h>
 
@@ -80,6 +86,94 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   p->Jbar[q] = pi;
 }
 
+/* ---- the stable form's J-bar space ---------------------------------------------------- */
+/* Nodes per axis in a point's support in the J-bar space of the stable form. */
+MPMC_ALWAYS_INLINE int stable_stencil(const int BASIS) { return BASIS == MPMC_BASIS_BSPLINE3 ? 3 : 2; }
+
+/* 1D weights w of the stable form's space at s = (x - origin)/h: *base is the grid node that
+ * stores the first of its nodes, the return value the step in grid nodes to the next one.
+ * Linear, uGIMP: hats of spacing 2h on the grid nodes of the parity of lo's (x = lo, lo + 2h,
+ * ...); quadratic B-splines: hats of spacing h centred on the cells (the hat at lo + (k + 1/2)
+ * h kept in node k); cubic: quadratic B-splines centred on the cells, kept likewise. */
+MPMC_ALWAYS_INLINE int stable_1d(const int BASIS, double s, int *base, double *w) {
+  double dw[3];
+  int b;
+  if (BASIS == MPMC_BASIS_LINEAR || BASIS == MPMC_BASIS_UGIMP) {
+    const int par = MPMC_GHOST % 2; /* node of x = lo */
+    mpmc_basis_1d(MPMC_BASIS_LINEAR, 0.5 * (s - par), 0.0, 1.0, &b, w, dw);
+    *base = par + 2 * b;
+    return 2;
+  }
+  mpmc_basis_1d(BASIS == MPMC_BASIS_BSPLINE3 ? MPMC_BASIS_BSPLINE2 : MPMC_BASIS_LINEAR, s - 0.5,
+                0.0, 1.0, &b, w, dw);
+  *base = b;
+  return 1;
+}
+
+typedef struct {
+  size_t node0;  /* grid node of the support's first node      */
+  size_t st[3];  /* step in node index to the next node per axis */
+  double w[3][3];
+} stable_pw;
+
+MPMC_ALWAYS_INLINE void stable_weights(const int DIM, const int BASIS, const mpmc_grid *g,
+                                       const double *x, stable_pw *sp) {
+  size_t node0 = 0, str = 1;
+  sp->st[1] = sp->st[2] = 0;
+  for (int a = 0; a < DIM; ++a) {
+    int b;
+    const int k = stable_1d(BASIS, (x[a] - g->origin[a]) * g->inv_h, &b, sp->w[a]);
+    node0 += str * (size_t)b;
+    sp->st[a] = str * (size_t)k;
+    str *= (size_t)g->n[a];
+  }
+  sp->node0 = node0;
+}
+
+/* The support of point q in the stable space: the body sees `node` and its weight `w`. */
+#define STABLE_LOOP(DIM, BASIS, sp, ...)                                                   \
+  do {                                                                                     \
+    const int S_ = stable_stencil(BASIS);                                                  \
+    for (int k_ = 0; k_ < (DIM == 3 ? S_ : 1); ++k_)                                       \
+      for (int j_ = 0; j_ < S_; ++j_) {                                                    \
+        const size_t r_ = (sp).node0 + (sp).st[1] * (size_t)j_ + (sp).st[2] * (size_t)k_;  \
+        const double wr_ = (sp).w[1][j_] * (DIM == 3 ? (sp).w[2][k_] : 1.0);               \
+        for (int i_ = 0; i_ < S_; ++i_) {                                                  \
+          const size_t node = r_ + (sp).st[0] * (size_t)i_;                                \
+          const double w = (sp).w[0][i_] * wr_;                                            \
+          __VA_ARGS__                                                                      \
+        }                                                                                  \
+      }                                                                                    \
+  } while (0)
+
+MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
+  mpmc_grid *g = &sim->grid;
+  mpmc_particles *p = &sim->p;
+  double *restrict fb = g->fb;
+  stable_pw sp;
+  stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
+  const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
+  const double Vn = p->vol0[q] * p->J[q] / dJ;
+  p->Jbar[q] *= dJ; /* until the gather: Jbar^n dJ, the denominator of eq 27 */
+  const mpmc_v2d vv = {Vn, Vn * p->J[q]};
+  STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
+}
+
+MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
+  const mpmc_grid *g = &sim->grid;
+  mpmc_particles *p = &sim->p;
+  const double *restrict fb = g->fb;
+  stable_pw sp;
+  stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
+  double pi = 0.0;
+  STABLE_LOOP(DIM, BASIS, sp, { pi += w * fb[2 * node + 1]; });
+  double *dF = p->dF + (size_t)q * DIM * DIM;
+  const double r = pi / p->Jbar[q];
+  const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
+  for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
+  p->Jbar[q] = pi;
+}
+
 /* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
 #define FBAR_KERNELS(D, B)                                                                   \
   static void scatter_##D##_##B(mpmc_sim sim) {                                              \
@@ -93,12 +187,61 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   static void gather_##D##_##B(mpmc_sim sim) {                                               \
     _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
     for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, q);                           \
+  }                                                                                          \
+  /* the stable form's supports reach one node past the basis' (cubic's reach): the slabs,  \
+   * three cells wide at least, keep same-coloured ones apart all the same */                \
+  static void scatter_stable_##D##_##B(mpmc_sim sim) {                                       \
+    const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
+    for (int colour = 0; colour < 2; ++colour) {                                             \
+      _Pragma("omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)")          \
+      for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
+        for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
+          scatter_stable_point(sim, D, B, order[k]);                                         \
+    }                                                                                        \
+  }                                                                                          \
+  static void gather_stable_##D##_##B(mpmc_sim sim) {                                        \
+    _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
+    for (int q = 0; q < sim->p.n; ++q) gather_stable_point(sim, D, B, q);                    \
   }
 MPMC_KERNELS(FBAR_KERNELS)
+
+/* The stable form: its supports reach at most one node beyond the active box per axis (the
+ * ghost layers hold them); the nodes it touches are cleared, summed, averaged and read. */
+static void fbar_stable(mpmc_sim sim) {
+  mpmc_grid *g = &sim->grid;
+  int lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  for (int a = 0; a < sim->dim; ++a) {
+    lo[a] = g->act_lo[a] > 0 ? g->act_lo[a] - 1 : 0;
+    hi[a] = g->act_hi[a] < g->n[a] ? g->act_hi[a] + 1 : g->n[a];
+  }
+  if (hi[0] <= lo[0] || g->act_hi[0] <= g->act_lo[0]) return;
+  const long ny = hi[1] - lo[1], nrow = ny * (hi[2] - lo[2]);
+  const size_t len = (size_t)(hi[0] - lo[0]);
+  double *restrict fb = g->fb;
+#define ROW(r) (fb + 2 * ((size_t)lo[0] + (size_t)g->n[0] * ((size_t)(lo[1] + (r) % ny) +             \
+                                                            (size_t)g->n[1] * (size_t)(lo[2] + (r) / ny))))
+  for (long r = 0; r < nrow; ++r) memset(ROW(r), 0, len * 2 * sizeof(double));
+  MPMC_KERNEL_CALL(scatter_stable_, sim, sim);
+#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+  for (long r = 0; r < nrow; ++r) {
+    double *f = ROW(r);
+    for (size_t i = 0; i < 2 * len; i += 2) f[i + 1] = f[i] > 0.0 ? f[i + 1] / f[i] : 0.0;
+  }
+#undef ROW
+  MPMC_KERNEL_CALL(gather_stable_, sim, sim);
+}
 
 /** Phase 4 of the step (only with F-bar on). */
 int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
+  if (sim->fbar == MPMC_FBAR_STABLE) {
+    g->fb_done = 0;
+    fbar_stable(sim);
+    double *t = sim->p.x;
+    sim->p.x = sim->p.xn;
+    sim->p.xn = t;
+    return MPMC_SUCCESS;
+  }
   /* the active box, row by row (the points' stencils lie in it) */
   const long nrow = mpmc_grid_active_rows(g);
   const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);

@@ -161,7 +161,7 @@ int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
     c.xmax[a] = g->hi[a] + g->h;
   }
   int bad = -1;
-  if (sim->fbar && g->fb) {
+  if (sim->fbar && sim->fbar != MPMC_FBAR_STABLE && g->fb) { /* stable: fbar.c scatters */
     MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, &bad);
     sim->grid.fb_done = 1;
   } else {

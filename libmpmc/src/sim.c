@@ -156,12 +156,13 @@ int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
 
 /**
  * @brief Choose the F-bar projection: MPMC_FBAR_OFF (0), MPMC_FBAR_PAPER (1, Algorithm 1 as
- * published) or MPMC_FBAR_TOTAL (2, the projection of det F).
+ * published), MPMC_FBAR_TOTAL (2, the projection of det F) or MPMC_FBAR_STABLE (3, the
+ * projection of det F onto a space one order below the basis; docs/theory.md).
  */
 int mpmc_sim_set_fbar(mpmc_sim sim, int mode) {
   if (!sim) return MPMC_ERR_ARG;
-  MPMC_CHECK(mode >= MPMC_FBAR_OFF && mode <= MPMC_FBAR_TOTAL, sim->ctx, MPMC_ERR_ARG,
-             "fbar = %d is not one of off (0), paper (1), total (2)", mode);
+  MPMC_CHECK(mode >= MPMC_FBAR_OFF && mode <= MPMC_FBAR_STABLE, sim->ctx, MPMC_ERR_ARG,
+             "fbar = %d is not one of off (0), paper (1), total (2), stable (3)", mode);
   sim->fbar = mode;
   sim->prepared = 0;
   return MPMC_SUCCESS;
