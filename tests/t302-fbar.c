@@ -71,30 +71,54 @@ static void homogeneous(int dim, int basis, int mode) {
   test_ctx = NULL;
 }
 
+#define NCELL 12
+/* points inside the box where every node in reach has its full support of points */
+static int interior(int dim, const double *x) {
+  int in = 1;
+  for (int a = 0; a < dim; ++a) in &= x[a] > 4.5 && x[a] < NCELL - 4.5;
+  return in;
+}
+
+/* A sim whose points carry an isotropic dF of det j(x) (Jbar^n = 1, J = j), projected. */
+static mpmc_sim project(mpmc_context ctx, int dim, int basis, int mode,
+                        double (*jof)(int dim, const double *x), double **x, int *n) {
+  mpmc_sim sim = make(ctx, dim, basis, mode, NCELL, x, n);
+  for (int q = 0; q < *n; ++q) {
+    const double j = jof(dim, *x + q * dim), s = dim == 2 ? sqrt(j) : cbrt(j);
+    for (int k = 0; k < dim * dim; ++k) sim->p.dF[q * dim * dim + k] = (k % (dim + 1) == 0) ? s : 0.0;
+    sim->p.Jbar[q] = 1.0;
+    sim->p.J[q] = j;
+  }
+  TCALL(mpmc_fbar(sim));
+  return sim;
+}
+
+static void finish(mpmc_sim *sim, mpmc_context *ctx, double *x) {
+  free(x);
+  mpmc_sim_destroy(sim);
+  mpmc_context_destroy(ctx);
+  test_ctx = NULL;
+}
+
+/* alternating volume change from point to point (2 points per cell per axis) */
+static const double ja = 1.02, jb = 0.96;
+static double j_checkerboard(int dim, const double *x) {
+  int parity = 0;
+  for (int a = 0; a < dim; ++a) parity += (int)floor(2.0 * x[a]);
+  return parity % 2 ? ja : jb;
+}
+
 static void checkerboard(int dim, int basis, int mode) {
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
   double *x;
   int n;
-  const int ncell = 12;
-  mpmc_sim sim = make(ctx, dim, basis, mode, ncell, &x, &n);
-  const double ja = 1.02, jb = 0.96; /* alternating volume change per point */
-  for (int q = 0; q < n; ++q) {
-    int parity = 0;
-    for (int a = 0; a < dim; ++a) parity += (int)floor(2.0 * x[q * dim + a]);
-    const double j = parity % 2 ? ja : jb, s = dim == 2 ? sqrt(j) : cbrt(j);
-    for (int k = 0; k < dim * dim; ++k) sim->p.dF[q * dim * dim + k] = (k % (dim + 1) == 0) ? s : 0.0;
-    sim->p.Jbar[q] = 1.0;
-    sim->p.J[q] = j;
-  }
-  TCALL(mpmc_fbar(sim));
+  mpmc_sim sim = project(ctx, dim, basis, mode, j_checkerboard, &x, &n);
   const double mean = 0.5 * (ja + jb);
   int checked = 0;
   for (int q = 0; q < n; ++q) {
-    int interior = 1;
-    for (int a = 0; a < dim; ++a) interior &= x[q * dim + a] > 4.5 && x[q * dim + a] < ncell - 4.5; /* node supports full */
-    if (!interior) continue;
+    if (!interior(dim, x + q * dim)) continue;
     ++checked;
     if (fabs(sim->p.Jbar[q] - mean) > 1e-13)
       fail_msg("dim %d basis %d mode %d point %d: projected J %.17g, expected the average %.17g",
@@ -102,62 +126,50 @@ static void checkerboard(int dim, int basis, int mode) {
     TCLOSE(det(dim, sim->p.dF + q * dim * dim), mean, 1e-13);
   }
   assert_true(checked > 0);
-  free(x);
-  mpmc_sim_destroy(&sim);
-  mpmc_context_destroy(&ctx);
-  test_ctx = NULL;
+  finish(&sim, &ctx, x);
 }
 
-/* J = 1 + e sum_a cos(pi x_a) (h = 1): the largest |Jbar - 1| over the interior points */
+/* the mode of period 2h (h = 1) */
+static const double e_mode = 1e-3;
+static double j_nodal_mode(int dim, const double *x) {
+  double j = 1.0;
+  for (int a = 0; a < dim; ++a) j += e_mode * cos(M_PI * x[a]);
+  return j;
+}
+
+/* J = 1 + e sum_a cos(pi x_a): the largest |Jbar - 1| / e over the interior points */
 static double nodal_mode(int dim, int basis, int mode) {
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
   double *x;
   int n;
-  const int ncell = 12;
-  const double e = 1e-3;
-  mpmc_sim sim = make(ctx, dim, basis, mode, ncell, &x, &n);
-  for (int q = 0; q < n; ++q) {
-    double j = 1.0;
-    for (int a = 0; a < dim; ++a) j += e * cos(M_PI * x[q * dim + a]);
-    const double s = dim == 2 ? sqrt(j) : cbrt(j);
-    for (int k = 0; k < dim * dim; ++k) sim->p.dF[q * dim * dim + k] = (k % (dim + 1) == 0) ? s : 0.0;
-    sim->p.Jbar[q] = 1.0;
-    sim->p.J[q] = j;
-  }
-  TCALL(mpmc_fbar(sim));
+  mpmc_sim sim = project(ctx, dim, basis, mode, j_nodal_mode, &x, &n);
   double worst = 0.0;
   for (int q = 0; q < n; ++q) {
-    int interior = 1;
-    for (int a = 0; a < dim; ++a) interior &= x[q * dim + a] > 4.5 && x[q * dim + a] < ncell - 4.5;
-    if (!interior) continue;
-    worst = fmax(worst, fabs(sim->p.Jbar[q] - 1.0) / e);
+    if (!interior(dim, x + q * dim)) continue;
+    worst = fmax(worst, fabs(sim->p.Jbar[q] - 1.0) / e_mode);
     TCLOSE(det(dim, sim->p.dF + q * dim * dim), sim->p.Jbar[q], 1e-13);
   }
-  free(x);
-  mpmc_sim_destroy(&sim);
-  mpmc_context_destroy(&ctx);
-  test_ctx = NULL;
+  finish(&sim, &ctx, x);
   return worst;
+}
+
+/* check(dim, basis, form) for both dimensions, every basis and every F-bar form */
+static void every_case(void (*check)(int, int, int)) {
+  for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_STABLE; ++m)
+    for (int b = 0; b < 4; ++b)
+      for (int d = 2; d <= 3; ++d) check(d, b, m);
 }
 
 static void test_homogeneous(void **state) {
   (void)state;
-  for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_STABLE; ++m)
-    for (int b = 0; b < 4; ++b) {
-      homogeneous(2, b, m);
-      homogeneous(3, b, m);
-    }
+  every_case(homogeneous);
 }
 
 static void test_checkerboard(void **state) {
   (void)state;
-  for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_STABLE; ++m)
-    for (int b = 0; b < 4; ++b) {
-      checkerboard(2, b, m);
-      checkerboard(3, b, m);
-    }
+  every_case(checkerboard);
 }
 
 static void test_nodal_mode(void **state) {

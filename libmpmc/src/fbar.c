@@ -12,9 +12,9 @@
  * centred on the cells for quadratic B-splines, quadratic B-splines centred on the cells for
  * cubic ones.  With w the weights of that space the formulas above are unchanged.
  * V_p is the volume at t^n.  In a step the scatter runs fused into G2P (which has the
- * weights at x^n at hand and sets grid.fb_done), except in the stable form, whose weights
- * G2P does not have; called on its own (tests), or in the stable form, the projection
- * scatters here, recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter
+ * points at x^n and, but in the stable form, the weights at hand; it sets grid.fb_done);
+ * called on its own (tests) the projection scatters here, recovering V_p as V0 J^{n+1} / dJ
+ * (G2P has already updated J).  The scatter
  * leaves Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
  * Touches nothing but dF (handed to the material), Jbar and the grid's fb. */
 #include <math.h>
@@ -86,87 +86,27 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   p->Jbar[q] = pi;
 }
 
-/* ---- the stable form's J-bar space ---------------------------------------------------- */
-/* Nodes per axis in a point's support in the J-bar space of the stable form. */
-MPMC_ALWAYS_INLINE int stable_stencil(const int BASIS) { return BASIS == MPMC_BASIS_BSPLINE3 ? 3 : 2; }
-
-/* 1D weights w of the stable form's space at s = (x - origin)/h: *base is the grid node that
- * stores the first of its nodes, the return value the step in grid nodes to the next one.
- * Linear, uGIMP: hats of spacing 2h on the grid nodes of the parity of lo's (x = lo, lo + 2h,
- * ...); quadratic B-splines: hats of spacing h centred on the cells (the hat at lo + (k + 1/2)
- * h kept in node k); cubic: quadratic B-splines centred on the cells, kept likewise. */
-MPMC_ALWAYS_INLINE int stable_1d(const int BASIS, double s, int *base, double *w) {
-  double dw[3];
-  int b;
-  if (BASIS == MPMC_BASIS_LINEAR || BASIS == MPMC_BASIS_UGIMP) {
-    const int par = MPMC_GHOST % 2; /* node of x = lo */
-    mpmc_basis_1d(MPMC_BASIS_LINEAR, 0.5 * (s - par), 0.0, 1.0, &b, w, dw);
-    *base = par + 2 * b;
-    return 2;
-  }
-  mpmc_basis_1d(BASIS == MPMC_BASIS_BSPLINE3 ? MPMC_BASIS_BSPLINE2 : MPMC_BASIS_LINEAR, s - 0.5,
-                0.0, 1.0, &b, w, dw);
-  *base = b;
-  return 1;
-}
-
-typedef struct {
-  size_t node0;  /* grid node of the support's first node      */
-  size_t st[3];  /* step in node index to the next node per axis */
-  double w[3][3];
-} stable_pw;
-
-MPMC_ALWAYS_INLINE void stable_weights(const int DIM, const int BASIS, const mpmc_grid *g,
-                                       const double *x, stable_pw *sp) {
-  size_t node0 = 0, str = 1;
-  sp->st[1] = sp->st[2] = 0;
-  for (int a = 0; a < DIM; ++a) {
-    int b;
-    const int k = stable_1d(BASIS, (x[a] - g->origin[a]) * g->inv_h, &b, sp->w[a]);
-    node0 += str * (size_t)b;
-    sp->st[a] = str * (size_t)k;
-    str *= (size_t)g->n[a];
-  }
-  sp->node0 = node0;
-}
-
-/* The support of point q in the stable space: the body sees `node` and its weight `w`. */
-#define STABLE_LOOP(DIM, BASIS, sp, ...)                                                   \
-  do {                                                                                     \
-    const int S_ = stable_stencil(BASIS);                                                  \
-    for (int k_ = 0; k_ < (DIM == 3 ? S_ : 1); ++k_)                                       \
-      for (int j_ = 0; j_ < S_; ++j_) {                                                    \
-        const size_t r_ = (sp).node0 + (sp).st[1] * (size_t)j_ + (sp).st[2] * (size_t)k_;  \
-        const double wr_ = (sp).w[1][j_] * (DIM == 3 ? (sp).w[2][k_] : 1.0);               \
-        for (int i_ = 0; i_ < S_; ++i_) {                                                  \
-          const size_t node = r_ + (sp).st[0] * (size_t)i_;                                \
-          const double w = (sp).w[0][i_] * wr_;                                            \
-          __VA_ARGS__                                                                      \
-        }                                                                                  \
-      }                                                                                    \
-  } while (0)
-
 MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   double *restrict fb = g->fb;
-  stable_pw sp;
-  stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
+  mpmc_spw sp;
+  mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
   const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
   const double Vn = p->vol0[q] * p->J[q] / dJ;
   p->Jbar[q] *= dJ; /* until the gather: Jbar^n dJ, the denominator of eq 27 */
   const mpmc_v2d vv = {Vn, Vn * p->J[q]};
-  STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
+  MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
 }
 
 MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double *restrict fb = g->fb;
-  stable_pw sp;
-  stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
+  mpmc_spw sp;
+  mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
   double pi = 0.0;
-  STABLE_LOOP(DIM, BASIS, sp, { pi += w * fb[2 * node + 1]; });
+  MPMC_STABLE_LOOP(DIM, BASIS, sp, { pi += w * fb[2 * node + 1]; });
   double *dF = p->dF + (size_t)q * DIM * DIM;
   const double r = pi / p->Jbar[q];
   const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
@@ -206,28 +146,26 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
 MPMC_KERNELS(FBAR_KERNELS)
 
 /* The stable form: its supports reach at most one node beyond the active box per axis (the
- * ghost layers hold them); the nodes it touches are cleared, summed, averaged and read. */
+ * ghost layers hold them); G2P has cleared and scattered them (fb_done), or, called on its
+ * own, the projection does it here; then the nodal average over that box and the gather. */
 static void fbar_stable(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
-  int lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  for (int a = 0; a < sim->dim; ++a) {
-    lo[a] = g->act_lo[a] > 0 ? g->act_lo[a] - 1 : 0;
-    hi[a] = g->act_hi[a] < g->n[a] ? g->act_hi[a] + 1 : g->n[a];
+  if (!g->fb_done) {
+    mpmc_grid_clear_fb_ring(g);
+    MPMC_KERNEL_CALL(scatter_stable_, sim, sim);
   }
-  if (hi[0] <= lo[0] || g->act_hi[0] <= g->act_lo[0]) return;
+  g->fb_done = 0;
+  int lo[3], hi[3];
+  mpmc_grid_fb_ring_box(g, lo, hi);
   const long ny = hi[1] - lo[1], nrow = ny * (hi[2] - lo[2]);
   const size_t len = (size_t)(hi[0] - lo[0]);
   double *restrict fb = g->fb;
-#define ROW(r) (fb + 2 * ((size_t)lo[0] + (size_t)g->n[0] * ((size_t)(lo[1] + (r) % ny) +             \
-                                                            (size_t)g->n[1] * (size_t)(lo[2] + (r) / ny))))
-  for (long r = 0; r < nrow; ++r) memset(ROW(r), 0, len * 2 * sizeof(double));
-  MPMC_KERNEL_CALL(scatter_stable_, sim, sim);
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
-    double *f = ROW(r);
+    double *f = fb + 2 * ((size_t)lo[0] + (size_t)g->n[0] * ((size_t)(lo[1] + r % ny) +
+                                                             (size_t)g->n[1] * (size_t)(lo[2] + r / ny)));
     for (size_t i = 0; i < 2 * len; i += 2) f[i + 1] = f[i] > 0.0 ? f[i + 1] / f[i] : 0.0;
   }
-#undef ROW
   MPMC_KERNEL_CALL(gather_stable_, sim, sim);
 }
 
@@ -235,7 +173,6 @@ static void fbar_stable(mpmc_sim sim) {
 int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   if (sim->fbar == MPMC_FBAR_STABLE) {
-    g->fb_done = 0;
     fbar_stable(sim);
     double *t = sim->p.x;
     sim->p.x = sim->p.xn;

@@ -18,8 +18,10 @@ typedef struct {
  * stencil the sums over the row's node records, sw = sum w_x rec and sd = sum w_x' rec, give
  *   (v_pic, dv) += wyz sw,  L_a. += (wyz sd_va, dyz sw_va, ydz sw_va),
  * all whole-vector multiply-adds in record layout; the components are picked out once.
- * FB: also scatter the F-bar volumes V^n and V^n j of Algorithm 1 step 3 with the same
- * weights (the points are still at x^n); the caller runs the points in slab colours. */
+ * FB = 1: also scatter the F-bar volumes V^n and V^n j of Algorithm 1 step 3 with the same
+ * weights (the points are still at x^n); FB = 2 (the stable form): scatter V^n and V^n J with
+ * the weights of its own space (transfer.h); either way the caller runs the points in slab
+ * colours. */
 MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, const int FB,
                                  double dt, const g2p_ctx *c, int q) {
   mpmc_grid *g = &sim->grid;
@@ -74,21 +76,27 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   if (FB) {
     const double Vn = p->vol0[q] * Jn;
     const double jd = p->Jbar[q] * dJ; /* kept for the gather (fbar.c) */
-    vv = (mpmc_v2d){Vn, Vn * (sim->fbar == MPMC_FBAR_TOTAL ? p->J[q] : jd)};
+    vv = (mpmc_v2d){Vn, Vn * (sim->fbar == MPMC_FBAR_PAPER ? jd : p->J[q])};
     p->Jbar[q] = jd;
   }
-  if (SPLIT || FB) {
+  if (FB == 2) {
+    double *restrict fb = g->fb;
+    mpmc_spw sp;
+    mpmc_stable_weights(DIM, BASIS, g, p->x + qd, &sp);
+    MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
+  }
+  if (SPLIT || FB == 1) {
     double *restrict fb = g->fb;
     MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
       mpmc_vd sw[MPMC_NV];
       for (int k = N1; k < NV; ++k) sw[k] = zero;
       const double *restrict r = rec + row * R;
-      double *restrict f = FB ? fb + row * 2 : NULL;
+      double *restrict f = FB == 1 ? fb + row * 2 : NULL;
       const mpmc_v2d cv = wyz * vv;
       for (int i = 0; i < S; ++i) {
         const double wx = pw.w[0][i];
         for (int k = N1; k < NV; ++k) sw[k] += wx * MPMC_VC(r + i * R + MPMC_VW * k);
-        if (FB) MPMC_V2(f + 2 * i) += wx * cv;
+        if (FB == 1) MPMC_V2(f + 2 * i) += wx * cv;
       }
       for (int k = N1; k < NV; ++k) A[k] += wyz * sw[k];
     });
@@ -123,13 +131,17 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   }                                                                                          \
   static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {         \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
+    const int fb = sim->fbar == MPMC_FBAR_STABLE ? 2 : 1;                                    \
     int first_bad = INT_MAX;                                                                 \
     for (int colour = 0; colour < 2; ++colour) {                                             \
       _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
-        for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
-          if (!g2p_point(sim, D, B, 1, dt, c, order[k]) && order[k] < first_bad)             \
-            first_bad = order[k];                                                            \
+        for (int k = start[sl]; k < start[sl + 1]; ++k) {                                    \
+          const int q_ = order[k];                                                           \
+          const int ok_ = fb == 2 ? g2p_point(sim, D, B, 2, dt, c, q_)                       \
+                                  : g2p_point(sim, D, B, 1, dt, c, q_);                      \
+          if (!ok_ && q_ < first_bad) first_bad = q_;                                        \
+        }                                                                                    \
     }                                                                                        \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
   }
@@ -161,7 +173,9 @@ int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
     c.xmax[a] = g->hi[a] + g->h;
   }
   int bad = -1;
-  if (sim->fbar && sim->fbar != MPMC_FBAR_STABLE && g->fb) { /* stable: fbar.c scatters */
+  if (sim->fbar && g->fb) {
+    /* the stable form's supports reach one node past the active box that P2G cleared */
+    if (sim->fbar == MPMC_FBAR_STABLE) mpmc_grid_clear_fb_ring(&sim->grid);
     MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, &bad);
     sim->grid.fb_done = 1;
   } else {

@@ -63,6 +63,66 @@ MPMC_ALWAYS_INLINE double mpmc_det_dim(const int DIM, const double *F) {
                         F[2] * (F[3] * F[7] - F[4] * F[6]);
 }
 
+/* ---- the J-bar space of the stable form of F-bar (fbar.c, fused into g2p.c) ---------- */
+/* Nodes per axis in a point's support in the J-bar space of the stable form. */
+MPMC_ALWAYS_INLINE int mpmc_stable_stencil(const int BASIS) { return BASIS == MPMC_BASIS_BSPLINE3 ? 3 : 2; }
+
+/* 1D weights w of the stable form's space at s = (x - origin)/h: *base is the grid node that
+ * stores the first of its nodes, the return value the step in grid nodes to the next one.
+ * Linear, uGIMP: hats of spacing 2h on the grid nodes of the parity of lo's (x = lo, lo + 2h,
+ * ...); quadratic B-splines: hats of spacing h centred on the cells (the hat at lo + (k + 1/2)
+ * h kept in node k); cubic: quadratic B-splines centred on the cells, kept likewise. */
+MPMC_ALWAYS_INLINE int mpmc_stable_1d(const int BASIS, double s, int *base, double *w) {
+  double dw[3];
+  int b;
+  if (BASIS == MPMC_BASIS_LINEAR || BASIS == MPMC_BASIS_UGIMP) {
+    const int par = MPMC_GHOST % 2; /* node of x = lo */
+    mpmc_basis_1d(MPMC_BASIS_LINEAR, 0.5 * (s - par), 0.0, 1.0, &b, w, dw);
+    *base = par + 2 * b;
+    return 2;
+  }
+  mpmc_basis_1d(BASIS == MPMC_BASIS_BSPLINE3 ? MPMC_BASIS_BSPLINE2 : MPMC_BASIS_LINEAR, s - 0.5,
+                0.0, 1.0, &b, w, dw);
+  *base = b;
+  return 1;
+}
+
+typedef struct {
+  size_t node0;  /* grid node of the support's first node      */
+  size_t st[3];  /* step in node index to the next node per axis */
+  double w[3][3];
+} mpmc_spw;
+
+MPMC_ALWAYS_INLINE void mpmc_stable_weights(const int DIM, const int BASIS, const mpmc_grid *g,
+                                       const double *x, mpmc_spw *sp) {
+  size_t node0 = 0, str = 1;
+  sp->st[1] = sp->st[2] = 0;
+  for (int a = 0; a < DIM; ++a) {
+    int b;
+    const int k = mpmc_stable_1d(BASIS, (x[a] - g->origin[a]) * g->inv_h, &b, sp->w[a]);
+    node0 += str * (size_t)b;
+    sp->st[a] = str * (size_t)k;
+    str *= (size_t)g->n[a];
+  }
+  sp->node0 = node0;
+}
+
+/* The support of point q in the stable space: the body sees `node` and its weight `w`. */
+#define MPMC_STABLE_LOOP(DIM, BASIS, sp, ...)                                                   \
+  do {                                                                                     \
+    const int S_ = mpmc_stable_stencil(BASIS);                                                  \
+    for (int k_ = 0; k_ < (DIM == 3 ? S_ : 1); ++k_)                                       \
+      for (int j_ = 0; j_ < S_; ++j_) {                                                    \
+        const size_t r_ = (sp).node0 + (sp).st[1] * (size_t)j_ + (sp).st[2] * (size_t)k_;  \
+        const double wr_ = (sp).w[1][j_] * (DIM == 3 ? (sp).w[2][k_] : 1.0);               \
+        for (int i_ = 0; i_ < S_; ++i_) {                                                  \
+          const size_t node = r_ + (sp).st[0] * (size_t)i_;                                \
+          const double w = (sp).w[0][i_] * wr_;                                            \
+          __VA_ARGS__                                                                      \
+        }                                                                                  \
+      }                                                                                    \
+  } while (0)
+
 /* Loop over the stencil's rows along x (nodes node0 + i, i < S, contiguous in memory): the
  * body sees `row` (linear index of the row's first node) and the row's factors of the
  * tensor-product weight, `wyz` = w_y w_z, `dyz` = w_y' w_z and `ydz` = w_y w_z' (0 in 2D), so
