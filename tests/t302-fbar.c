@@ -79,10 +79,13 @@ static int interior(int dim, const double *x) {
   return in;
 }
 
-/* A sim whose points carry an isotropic dF of det j(x) (Jbar^n = 1, J = j), projected. */
-static mpmc_sim project(mpmc_context ctx, int dim, int basis, int mode,
+/* A context and a sim whose points carry an isotropic dF of det j(x) (Jbar^n = 1, J = j),
+ * projected; finish() frees them. */
+static mpmc_sim project(mpmc_context *ctx, int dim, int basis, int mode,
                         double (*jof)(int dim, const double *x), double **x, int *n) {
-  mpmc_sim sim = make(ctx, dim, basis, mode, NCELL, x, n);
+  TCALL(mpmc_context_create(ctx));
+  test_ctx = *ctx;
+  mpmc_sim sim = make(*ctx, dim, basis, mode, NCELL, x, n);
   for (int q = 0; q < *n; ++q) {
     const double j = jof(dim, *x + q * dim), s = dim == 2 ? sqrt(j) : cbrt(j);
     for (int k = 0; k < dim * dim; ++k) sim->p.dF[q * dim * dim + k] = (k % (dim + 1) == 0) ? s : 0.0;
@@ -110,11 +113,9 @@ static double j_checkerboard(int dim, const double *x) {
 
 static void checkerboard(int dim, int basis, int mode) {
   mpmc_context ctx;
-  TCALL(mpmc_context_create(&ctx));
-  test_ctx = ctx;
   double *x;
   int n;
-  mpmc_sim sim = project(ctx, dim, basis, mode, j_checkerboard, &x, &n);
+  mpmc_sim sim = project(&ctx, dim, basis, mode, j_checkerboard, &x, &n);
   const double mean = 0.5 * (ja + jb);
   int checked = 0;
   for (int q = 0; q < n; ++q) {
@@ -140,11 +141,9 @@ static double j_nodal_mode(int dim, const double *x) {
 /* J = 1 + e sum_a cos(pi x_a): the largest |Jbar - 1| / e over the interior points */
 static double nodal_mode(int dim, int basis, int mode) {
   mpmc_context ctx;
-  TCALL(mpmc_context_create(&ctx));
-  test_ctx = ctx;
   double *x;
   int n;
-  mpmc_sim sim = project(ctx, dim, basis, mode, j_nodal_mode, &x, &n);
+  mpmc_sim sim = project(&ctx, dim, basis, mode, j_nodal_mode, &x, &n);
   double worst = 0.0;
   for (int q = 0; q < n; ++q) {
     if (!interior(dim, x + q * dim)) continue;

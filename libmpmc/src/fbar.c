@@ -22,6 +22,16 @@
 
 #include "transfer.h"
 
+/* What point q scatters, (V^n, V^n j), V^n recovered as V0 J^{n+1} / dJ; leaves Jbar^n dJ
+ * in Jbar until the gather (the denominator of eq 27). */
+MPMC_ALWAYS_INLINE mpmc_v2d scatter_values(mpmc_sim sim, const int DIM, int q) {
+  mpmc_particles *p = &sim->p;
+  const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
+  const double Vn = p->vol0[q] * p->J[q] / dJ;
+  p->Jbar[q] *= dJ;
+  return (mpmc_v2d){Vn, Vn * (sim->fbar == MPMC_FBAR_PAPER ? p->Jbar[q] : p->J[q])};
+}
+
 /* Scatter point q: V^n and V^n j onto its nodes (Algorithm 1, step 3). */
 MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
@@ -31,13 +41,7 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
-  const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
-  const double Vn = p->vol0[q] * p->J[q] / dJ;
-  const double jd = p->Jbar[q] * dJ;
-  const double val = sim->fbar == MPMC_FBAR_TOTAL ? p->J[q] : jd;
-  p->Jbar[q] = jd; /* until the gather: Jbar^n dJ, the denominator of eq 27 */
-  const double Vv = Vn * val;
-  const mpmc_v2d vv = {Vn, Vv};
+  const mpmc_v2d vv = scatter_values(sim, DIM, q);
   MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
     const mpmc_v2d cv = wyz * vv;
     double *restrict r = fb + row * 2;
@@ -63,6 +67,16 @@ static inline double cbrt_near1(double r) {
   return r * y * y;
 }
 
+/* Point q's projected Jacobian pi: scale dF by (pi / (Jbar^n dJ))^(1/dim) (eq 27; the
+ * scatter left Jbar^n dJ in Jbar), keep pi as Jbar. */
+MPMC_ALWAYS_INLINE void apply_projection(mpmc_particles *p, const int DIM, int q, double pi) {
+  double *dF = p->dF + (size_t)q * DIM * DIM;
+  const double r = pi / p->Jbar[q];
+  const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
+  for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
+  p->Jbar[q] = pi;
+}
+
 /* Gather point q: Pi = sum w Jbar_i, scale dF (Algorithm 1, step 4). */
 MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   const mpmc_grid *g = &sim->grid;
@@ -79,11 +93,7 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
     for (int i = 0; i < S; ++i) sr += pw.w[0][i] * r[2 * i];
     pi += wyz * sr;
   });
-  double *dF = p->dF + (size_t)q * DIM * DIM;
-  const double r = pi / p->Jbar[q]; /* the scatter left Jbar^n dJ there */
-  const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
-  for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
-  p->Jbar[q] = pi;
+  apply_projection(p, DIM, q, pi);
 }
 
 MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
@@ -92,10 +102,7 @@ MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const 
   double *restrict fb = g->fb;
   mpmc_spw sp;
   mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
-  const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
-  const double Vn = p->vol0[q] * p->J[q] / dJ;
-  p->Jbar[q] *= dJ; /* until the gather: Jbar^n dJ, the denominator of eq 27 */
-  const mpmc_v2d vv = {Vn, Vn * p->J[q]};
+  const mpmc_v2d vv = scatter_values(sim, DIM, q);
   MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
 }
 
@@ -107,11 +114,7 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
   mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
   double pi = 0.0;
   MPMC_STABLE_LOOP(DIM, BASIS, sp, { pi += w * fb[2 * node + 1]; });
-  double *dF = p->dF + (size_t)q * DIM * DIM;
-  const double r = pi / p->Jbar[q];
-  const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
-  for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
-  p->Jbar[q] = pi;
+  apply_projection(p, DIM, q, pi);
 }
 
 /* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
@@ -145,19 +148,27 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
   }
 MPMC_KERNELS(FBAR_KERNELS)
 
-/* The stable form: its supports reach at most one node beyond the active box per axis (the
- * ghost layers hold them); G2P has cleared and scattered them (fb_done), or, called on its
- * own, the projection does it here; then the nodal average over that box and the gather. */
-static void fbar_stable(mpmc_sim sim) {
+/** Phase 4 of the step (only with F-bar on).  The nodes it touches: the active box (the
+ * points' stencils lie in it), grown by one node per axis in the stable form, whose supports
+ * reach one node further (the ghost layers hold them). */
+int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
-  if (!g->fb_done) {
-    mpmc_grid_clear_fb_ring(g);
-    MPMC_KERNEL_CALL(scatter_stable_, sim, sim);
+  const int stable = sim->fbar == MPMC_FBAR_STABLE;
+  int lo[3], hi[3];
+  if (stable)
+    mpmc_grid_fb_ring_box(g, lo, hi);
+  else
+    for (int a = 0; a < 3; ++a) lo[a] = g->act_lo[a], hi[a] = g->act_hi[a];
+  if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
+    mpmc_grid_clear_fb_box(g, lo, hi);
+    if (stable)
+      MPMC_KERNEL_CALL(scatter_stable_, sim, sim);
+    else
+      MPMC_KERNEL_CALL(scatter_, sim, sim);
   }
   g->fb_done = 0;
-  int lo[3], hi[3];
-  mpmc_grid_fb_ring_box(g, lo, hi);
-  const long ny = hi[1] - lo[1], nrow = ny * (hi[2] - lo[2]);
+  /* nodal volume average (Algorithm 1 step 3), row by row */
+  const long ny = hi[1] - lo[1], nrow = hi[0] > lo[0] ? ny * (hi[2] - lo[2]) : 0;
   const size_t len = (size_t)(hi[0] - lo[0]);
   double *restrict fb = g->fb;
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
@@ -166,36 +177,10 @@ static void fbar_stable(mpmc_sim sim) {
                                                              (size_t)g->n[1] * (size_t)(lo[2] + r / ny)));
     for (size_t i = 0; i < 2 * len; i += 2) f[i + 1] = f[i] > 0.0 ? f[i + 1] / f[i] : 0.0;
   }
-  MPMC_KERNEL_CALL(gather_stable_, sim, sim);
-}
-
-/** Phase 4 of the step (only with F-bar on). */
-int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
-  mpmc_grid *g = &sim->grid;
-  if (sim->fbar == MPMC_FBAR_STABLE) {
-    fbar_stable(sim);
-    double *t = sim->p.x;
-    sim->p.x = sim->p.xn;
-    sim->p.xn = t;
-    return MPMC_SUCCESS;
-  }
-  /* the active box, row by row (the points' stencils lie in it) */
-  const long nrow = mpmc_grid_active_rows(g);
-  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
-  double *restrict fb = g->fb;
-  if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
-    for (long r = 0; r < nrow; ++r)
-      memset(fb + mpmc_grid_active_row(g, r) * 2, 0, len * 2 * sizeof(double));
-    MPMC_KERNEL_CALL(scatter_, sim, sim);
-  }
-  g->fb_done = 0;
-  /* nodal volume average (Algorithm 1 step 3) */
-#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
-  for (long r = 0; r < nrow; ++r) {
-    double *f = fb + mpmc_grid_active_row(g, r) * 2;
-    for (size_t i = 0; i < 2 * len; i += 2) f[i + 1] = f[i] > 0.0 ? f[i + 1] / f[i] : 0.0;
-  }
-  MPMC_KERNEL_CALL(gather_, sim, sim);
+  if (stable)
+    MPMC_KERNEL_CALL(gather_stable_, sim, sim);
+  else
+    MPMC_KERNEL_CALL(gather_, sim, sim);
   /* the projection used the weights at x^n; now the points move (eq 17) */
   double *t = sim->p.x;
   sim->p.x = sim->p.xn;

@@ -99,6 +99,11 @@ void mpmc_grid_fb_ring_box(const mpmc_grid *g, int lo[3], int hi[3]) {
 void mpmc_grid_clear_fb_ring(mpmc_grid *g) {
   int lo[3], hi[3];
   mpmc_grid_fb_ring_box(g, lo, hi);
+  mpmc_grid_clear_fb_box(g, lo, hi);
+}
+
+void mpmc_grid_clear_fb_box(mpmc_grid *g, const int lo[3], const int hi[3]) {
+  if (hi[0] <= lo[0]) return;
   const size_t len = (size_t)(hi[0] - lo[0]);
   for (int k = lo[2]; k < hi[2]; ++k)
     for (int j = lo[1]; j < hi[1]; ++j) {
