@@ -5,7 +5,8 @@
  * code (library) and exit status (`mpmc`); output problems (a directory that cannot be
  * created, a full disk for the series and for the checkpoint) give a clear error and leave
  * the last checkpoint intact.  A full disk is real: files are symlinks to /dev/full, where
- * every write fails with ENOSPC. */
+ * every write fails with ENOSPC.  A flow with the stable F-bar form that blows up is stopped
+ * with a message naming the form and Algorithm 1 as the way out. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -158,6 +159,49 @@ static void test_forced_blowup(void **state) {
   expect_checkpoint("resumed", out, 0.02);
 }
 
+/* A coarse dam break (h = 0.5 m, 2x2 points per cell, K = 2 GPa) with the stable F-bar form:
+ * the points' own J drift in the surge (0.7-1.3 by t = 1 s), the stable form projects them,
+ * and the run-up at the far wall blows up at t = 1.02 s; the monitor's message names the
+ * form and the way out, Algorithm 1, with which the same scene runs past that time. */
+static const char *flow_fmt =
+    "dim: 2\n"
+    "plots: false\n"
+    "grid: {lo: [0, 0], hi: [6, 12], cell_size: 0.5}\n"
+    "basis: ugimp\n"
+    "fbar: %s\n"
+    "flip: 1.0\n"
+    "materials:\n"
+    "  water: {model: newtonian, K: 2.0e9, mu: 1.0e-3, rho: 997.5}\n"
+    "geometry:\n"
+    "  - {type: box, lo: [0, 0], hi: [4, 2], ppc: 2, material: water}\n"
+    "stages:\n"
+    "  - name: collapse\n"
+    "    gravity: [0, -9.81]\n"
+    "    walls: [{face: x_lo, kind: slip}, {face: x_hi, kind: slip}, {face: y_lo, kind: slip}]\n"
+    "    dt: 1.0e-5\n"
+    "    end: {time: 1.2}\n";
+
+static void test_total_form_flow(void **state) {
+  (void)state;
+  char scene[] = DIR "/flow.yaml", out[] = DIR "/out-flow", msg[4096];
+  mkdir(DIR, 0777);
+  for (int paper = 0; paper < 2; ++paper) {
+    FILE *f = fopen(scene, "w");
+    assert_non_null(f);
+    fprintf(f, flow_fmt, paper ? "true" : "stable");
+    fclose(f);
+    const int e = run_lib(scene, out, msg, sizeof msg);
+    if (paper) {
+      if (e) fail_msg("dam break with Algorithm 1: expected to complete, got %d: %s", e, msg);
+    } else {
+      if (e != MPMC_ERR_UNSTABLE) fail_msg("dam break, stable form: expected MPMC_ERR_UNSTABLE, got %d: %s", e, msg);
+      expect_in("flow", msg, "kinetic energy grows without input");
+      expect_in("flow", msg, "use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene 'fbar: true')");
+      expect_in("flow", msg, "the stable form projects the points' own J");
+    }
+  }
+}
+
 static void test_out_not_creatable(void **state) {
   (void)state;
   char scene[] = DIR "/ok.yaml", msg[4096];
@@ -227,7 +271,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_dt_refused),        cmocka_unit_test(test_forced_blowup),
       cmocka_unit_test(test_out_not_creatable), cmocka_unit_test(test_series_disk_full),
-      cmocka_unit_test(test_checkpoint_disk_full),
+      cmocka_unit_test(test_checkpoint_disk_full), cmocka_unit_test(test_total_form_flow),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

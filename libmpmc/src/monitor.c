@@ -26,6 +26,7 @@
  * with the stresses at each new baseline. */
 #include <limits.h>
 #include <math.h>
+#include <stdio.h>
 
 #include "mpmc_impl.h"
 
@@ -161,14 +162,26 @@ int mpmc_monitor_step(mpmc_sim sim) {
     }
   }
   const double *x = p->x + (size_t)q * d;
+  /* The forms that project det F itself follow the points' own J, which drifts in a large
+   * flow (splashing, run-up; docs/theory.md): say so, with the range of J. */
+  char hint[256] = "";
+  if (sim->fbar == MPMC_FBAR_TOTAL || sim->fbar == MPMC_FBAR_STABLE) {
+    double jmin = INFINITY, jmax = -INFINITY;
+    for (int i = 0; i < p->n; ++i) jmin = fmin(jmin, p->J[i]), jmax = fmax(jmax, p->J[i]);
+    snprintf(hint, sizeof hint,
+             "; or, in a large flow, use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene "
+             "'fbar: true'): the %s form projects the points' own J, which drift in a flow "
+             "(here %.3g to %.3g)",
+             sim->fbar == MPMC_FBAR_TOTAL ? "total" : "stable", jmin, jmax);
+  }
   return MPMC_ERROR(sim->ctx, MPMC_ERR_UNSTABLE,
                     "step %lld, t = %g: kinetic energy grows without input: E_k = %.4g J exceeds "
                     "%g x the %.4g J available since step %lld (kinetic %.3g + elastic %.3g + "
                     "work of gravity %.3g + of loads %.3g); fastest point %d at (%g, %g, %g), "
-                    "|v| = %.4g m/s: the run is unstable, reduce the time step",
+                    "|v| = %.4g m/s: the run is unstable, reduce the time step%s",
                     (long long)sim->stats.steps, sim->time, s.ke, factor, avail,
                     (long long)mo->base_step, mo->e0[0], mo->e0[1], wg, wf, q, x[0], x[1],
-                    d == 3 ? x[2] : 0.0, sqrt(s.v2max));
+                    d == 3 ? x[2] : 0.0, sqrt(s.v2max), hint);
 }
 
 /**
