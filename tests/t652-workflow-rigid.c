@@ -104,6 +104,19 @@ static void test_plate_on_block(void **state) {
   if (!(ratio > 0.5 * q && ratio < q))
     fail_msg("bearing_capacity_ratio su = %.6g Pa, expected between half and all of the final %.6g Pa "
              "(the load rises with the settlement)", ratio, q);
+  /* series.csv: the footing's metrics are undefined on the row before the first step, an
+   * empty field there, never "nan" (nor "inf", nor "-0") */
+  FILE *f = fopen(DIR "/out/series.csv", "r");
+  assert_non_null(f);
+  char line[4096];
+  int rows = 0;
+  while (fgets(line, sizeof line, f)) {
+    ++rows;
+    if (strstr(line, "nan") || strstr(line, "inf") || strstr(line, ",-0,"))
+      fail_msg("series.csv row %d holds a non-number: %s", rows, line);
+  }
+  fclose(f);
+  if (rows < 3) fail_msg("series.csv has %d rows, expected a header and the series", rows);
 }
 
 static void expect_bad(const char *stage_body, const char *metric_body, const char *key, const char *what) {

@@ -370,8 +370,10 @@ static int series_row(wf_run *w, int stage, long step, double dt, double ke, dou
   mpmc_sim_get_time(w->sim, &t);
   WF_TRY(w, wf_metrics_compute(w->sim, &w->sc, m), "metrics");
   fprintf(w->series, "%s,%.9g,%ld,%.6g,%.9g,%.6g", w->sc.stages[stage].name, t, step, dt, ke, ratio);
+  /* a metric not defined yet (the footing's ratio before its first step) is an empty field,
+     never a NaN; + 0.0 turns -0 into 0 */
   for (int k = 0; k < WF_METRIC_COUNT; ++k)
-    if (w->sc.metrics.enabled[k]) fprintf(w->series, ",%.9g", m[k]);
+    if (w->sc.metrics.enabled[k]) isfinite(m[k]) ? fprintf(w->series, ",%.9g", m[k] + 0.0) : fputc(',', w->series);
   fputc('\n', w->series);
   /* a full disk shows here first: stop with the reason instead of a silently short series */
   if (fflush(w->series) || ferror(w->series))
