@@ -111,18 +111,18 @@ static inline int return_map_point(mpmc_rm_ws *ws, int solver, const mpmc_j2_par
     info->plastic = 1;
     MPMC_CALL(mpmc_rm_solve_k(ws, solver, m, qtr, *eps_p, k0, &dg, &qn, info));
     const double f = qn / qtr; /* radial return: = 1 - 3G dgamma / q_trial */
-    for (int k = 0; k < 6; ++k) {
-      e[k] *= f;
-      en[k] = 2.0 * e[k];
-    }
+    /* b_e = exp(2 eps_new) = exp(2 eps_tr) exp(2 (f - 1) e) = b exp(2 (f - 1) e): b and the
+     * correction commute (both functions of e), and the correction's series is short for
+     * the small returns of most plastic steps (never longer than exp(2 e)'s) */
+    for (int k = 0; k < 6; ++k) en[k] = 2.0 * (f - 1.0) * e[k];
     if (mpmc_sym3_exp_series(en, bn)) { /* not reached for |eps| < 0.18; stay safe */
       *info = (mpmc_j2_info){0};
       return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
     }
-    const double v = exp(tr / 3.0), vol = v * v; /* one exp for exp(2 tr/3) and J */
-    for (int k = 0; k < 6; ++k) be[k] = vol * bn[k];
+    mpmc_sym3_mul(b, bn, be);
+    for (int k = 0; k < 6; ++k) e[k] *= f;
     *eps_p += dg;
-    J = vol * v;
+    J = exp(tr);
   } else {
     for (int k = 0; k < 6; ++k) be[k] = b[k]; /* elastic: keep b_e as pushed forward */
     J = exp(tr);
