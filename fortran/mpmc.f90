@@ -809,7 +809,7 @@ contains
     type(mpmc_context), intent(in) :: ctx
     character(len=:), allocatable, intent(out) :: msg
     integer(c_int) :: ierr
-    integer, parameter :: buflen = 1024 ! MPMC_MSG_LEN
+    integer, parameter :: buflen = 4096 ! MPMC_MSG_LEN
     character(kind=c_char) :: buf(buflen)
     integer :: i, n
     ierr = mpmc_context_get_last_error_c(ctx, buf, int(buflen, c_int))

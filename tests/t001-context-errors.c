@@ -13,7 +13,8 @@ static void test_error_strings(void **state) {
   (void)state;
   assert_string_equal(mpmc_error_string(MPMC_SUCCESS), "success");
   assert_string_equal(mpmc_error_string(MPMC_ERR_ARG), "invalid argument");
-  assert_string_equal(mpmc_error_string(MPMC_ERR_UNSTABLE), "time step above the stability limit");
+  assert_string_equal(mpmc_error_string(MPMC_ERR_UNSTABLE),
+                      "unstable run (time step above the stability limit, or energy growing without input)");
   for (int c = 0; c < MPMC_ERROR_COUNT; ++c) {
     const char *s = mpmc_error_string(c);
     if (!s || !*s || !strcmp(s, "unknown error code")) fail_msg("code %d has no message", c);

@@ -198,6 +198,10 @@ static void test_total_form_flow(void **state) {
       expect_in("flow", msg, "kinetic energy grows without input");
       expect_in("flow", msg, "use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene 'fbar: true')");
       expect_in("flow", msg, "the stable form projects the points' own J");
+      /* the whole report survives: the way back and where the failing state went (a
+         1024-byte buffer cut this message inside its last sentence) */
+      expect_in("flow", msg, "last good state: " DIR "/out-flow/checkpoint.h5 (t = 0 s)");
+      expect_in("flow", msg, "the failing state is the last snapshot in " DIR "/out-flow/snapshots.h5");
     }
   }
 }

@@ -27,7 +27,7 @@ static const char usage[] =
 
 /* The library's message without its "<code>: " prefix and " [file.c:line]" suffix. */
 static void print_error(mpmc_context ctx, int code) {
-  char msg[1200];
+  char msg[4096]; /* the library keeps up to MPMC_MSG_LEN = 4096 */
   snprintf(msg, sizeof msg, "%s", mpmc_context_last_error(ctx));
   const char *pre = mpmc_error_string(code);
   char *body = msg;

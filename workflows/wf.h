@@ -16,7 +16,7 @@
 
 #define WF_NAME 64
 #define WF_PATH 4096
-#define WF_MSG 1024
+#define WF_MSG 4096
 
 /* ---- the YAML tree (scene.c) ----------------------------------------------------- */
 typedef enum { WF_SCALAR = 0, WF_SEQ = 1, WF_MAP = 2 } wf_kind;

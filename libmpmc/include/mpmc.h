@@ -28,7 +28,7 @@ extern "C" {
   X(MPMC_ERR_STATE, "call out of order")                                          \
   X(MPMC_ERR_OUTSIDE, "material point outside the grid")                          \
   X(MPMC_ERR_NUMERIC, "numerical failure (NaN, Inf or inverted volume)")          \
-  X(MPMC_ERR_UNSTABLE, "time step above the stability limit")                     \
+  X(MPMC_ERR_UNSTABLE, "unstable run (time step above the stability limit, or energy growing without input)") \
   X(MPMC_ERR_SOLVER, "local solver did not converge")                             \
   X(MPMC_ERR_IO, "input/output error")                                            \
   X(MPMC_ERR_FORMAT, "malformed or incompatible file")                            \

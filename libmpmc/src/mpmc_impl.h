@@ -12,7 +12,7 @@
 #define MPMC_OMP_MIN 4096
 
 /* ---- context and errors (context.c, error.c) ---------------------------------- */
-#define MPMC_MSG_LEN 1024
+#define MPMC_MSG_LEN 4096 /* room for a monitor report plus two output paths (workflows) */
 struct mpmc_context_s {
   int last_code;
   char last_msg[MPMC_MSG_LEN];
