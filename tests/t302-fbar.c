@@ -186,11 +186,58 @@ static void test_nodal_mode(void **state) {
     }
 }
 
+/* After P2G's reset of the active box (mpmc_grid_clear_active) every F-bar sum in the grid
+ * is zero: every form's supports, the stable form's spaces too, lie in the active box.  A
+ * block translating through the grid, every form, basis and dimension, after each step. */
+static void test_fb_cleared(void **state) {
+  (void)state;
+  for (int dim = 2; dim <= 3; ++dim)
+    for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_STABLE; ++m)
+      for (int b = 0; b < 4; ++b) {
+        mpmc_context ctx;
+        TCALL(mpmc_context_create(&ctx));
+        test_ctx = ctx;
+        mpmc_sim sim;
+        TCALL(mpmc_sim_create(ctx, dim, &sim));
+        const double lo[3] = {-1, -1, -1}, hi[3] = {12, 6, 6};
+        TCALL(mpmc_sim_set_grid(sim, lo, hi, 1.0));
+        TCALL(mpmc_sim_set_basis(sim, b));
+        TCALL(mpmc_sim_set_fbar(sim, m));
+        int mat, n;
+        TCALL(mpmc_sim_add_material_hencky(sim, 1.0, 0.3, 1.0, &mat));
+        double *x, *vol;
+        const double plo[3] = {0, 0, 0}, phi[3] = {4, 4, 4};
+        n = test_lattice(dim, plo, phi, 1.0, 2, &x, &vol);
+        TCALL(mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
+        free(x);
+        free(vol);
+        TCALL(mpmc_sim_prepare(sim));
+        double *v;
+        TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+        for (int q = 0; q < n; ++q) v[q * dim] = 1.0; /* 1 cell/s along x */
+        double dt;
+        TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
+        const int steps = (int)(4.0 / dt); /* four cells on */
+        for (int s = 0; s < steps; ++s) {
+          TCALL(mpmc_sim_step(sim, dt));
+          mpmc_grid_clear_active(&sim->grid);
+          for (size_t i = 0; i < 2 * sim->grid.nn; ++i)
+            if (sim->grid.fb[i] != 0.0)
+              fail_msg("dim %d form %d basis %d step %d: fb[%zu] = %g after the reset", dim, m, b, s,
+                       i, sim->grid.fb[i]);
+        }
+        mpmc_sim_destroy(&sim);
+        mpmc_context_destroy(&ctx);
+        test_ctx = NULL;
+      }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_homogeneous),
       cmocka_unit_test(test_checkerboard),
       cmocka_unit_test(test_nodal_mode),
+      cmocka_unit_test(test_fb_cleared),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -131,8 +131,8 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
     _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
     for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, q);                           \
   }                                                                                          \
-  /* the stable form's supports reach one node past the basis' (cubic's reach): the slabs,  \
-   * three cells wide at least, keep same-coloured ones apart all the same */                \
+  /* the stable form's supports reach no further than the cubic B-spline's (nodes c - 1 ..  \
+   * c + 2 of a point in cell c): the slabs keep same-coloured ones apart all the same */    \
   static void scatter_stable_##D##_##B(mpmc_sim sim) {                                       \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
     for (int colour = 0; colour < 2; ++colour) {                                             \
@@ -148,19 +148,14 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
   }
 MPMC_KERNELS(FBAR_KERNELS)
 
-/** Phase 4 of the step (only with F-bar on).  The nodes it touches: the active box (the
- * points' stencils lie in it), grown by one node per axis in the stable form, whose supports
- * reach one node further (the ghost layers hold them). */
+/** Phase 4 of the step (only with F-bar on).  The nodes it touches: the active box, which
+ * holds every point's support in every form (the cubic B-spline's reach, c - 1 .. c + 2, is
+ * the widest; the stable form's spaces reach no further; t302 checks it). */
 int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   const int stable = sim->fbar == MPMC_FBAR_STABLE;
-  int lo[3], hi[3];
-  if (stable)
-    mpmc_grid_fb_ring_box(g, lo, hi);
-  else
-    for (int a = 0; a < 3; ++a) lo[a] = g->act_lo[a], hi[a] = g->act_hi[a];
   if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
-    mpmc_grid_clear_fb_box(g, lo, hi);
+    mpmc_grid_clear_fb_active(g);
     if (stable)
       MPMC_KERNEL_CALL(scatter_stable_, sim, sim);
     else
@@ -168,13 +163,12 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
   }
   g->fb_done = 0;
   /* nodal volume average (Algorithm 1 step 3), row by row */
-  const long ny = hi[1] - lo[1], nrow = hi[0] > lo[0] ? ny * (hi[2] - lo[2]) : 0;
-  const size_t len = (size_t)(hi[0] - lo[0]);
+  const long nrow = mpmc_grid_active_rows(g);
+  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
   double *restrict fb = g->fb;
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
-    double *f = fb + 2 * ((size_t)lo[0] + (size_t)g->n[0] * ((size_t)(lo[1] + r % ny) +
-                                                             (size_t)g->n[1] * (size_t)(lo[2] + r / ny)));
+    double *f = fb + 2 * mpmc_grid_active_row(g, r);
     for (size_t i = 0; i < 2 * len; i += 2) f[i + 1] = f[i] > 0.0 ? f[i + 1] / f[i] : 0.0;
   }
   if (stable)

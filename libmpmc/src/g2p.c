@@ -173,9 +173,7 @@ int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
     c.xmax[a] = g->hi[a] + g->h;
   }
   int bad = -1;
-  if (sim->fbar && g->fb) {
-    /* the stable form's supports reach one node past the active box that P2G cleared */
-    if (sim->fbar == MPMC_FBAR_STABLE) mpmc_grid_clear_fb_ring(&sim->grid);
+  if (sim->fbar && g->fb) { /* P2G left all of fb zero (mpmc_grid_clear_active) */
     MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, &bad);
     sim->grid.fb_done = 1;
   } else {

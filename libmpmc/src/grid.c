@@ -81,35 +81,18 @@ void mpmc_grid_clear_active(mpmc_grid *g) {
   for (long r = 0; r < nrow; ++r) {
     const size_t first = mpmc_grid_active_row(g, r);
     memset(g->node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
-    /* the F-bar sums whenever allocated: F-bar may have been on in an earlier step */
-    if (g->fb) memset(g->fb + first * 2, 0, len * 2 * sizeof(double));
   }
+  /* the F-bar sums whenever allocated (F-bar may have been on in an earlier step); every
+     form's supports lie in the active box */
+  if (g->fb) mpmc_grid_clear_fb_active(g);
   g->fb_done = 0;
 }
 
-void mpmc_grid_fb_ring_box(const mpmc_grid *g, int lo[3], int hi[3]) {
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = a < g->dim && g->act_lo[a] > 0 ? g->act_lo[a] - 1 : g->act_lo[a];
-    hi[a] = a < g->dim && g->act_hi[a] < g->n[a] ? g->act_hi[a] + 1 : g->act_hi[a];
-  }
-  if (g->act_hi[0] <= g->act_lo[0] || g->act_hi[1] <= g->act_lo[1] || g->act_hi[2] <= g->act_lo[2])
-    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = 0; /* no points: nothing to touch */
-}
-
-void mpmc_grid_clear_fb_ring(mpmc_grid *g) {
-  int lo[3], hi[3];
-  mpmc_grid_fb_ring_box(g, lo, hi);
-  mpmc_grid_clear_fb_box(g, lo, hi);
-}
-
-void mpmc_grid_clear_fb_box(mpmc_grid *g, const int lo[3], const int hi[3]) {
-  if (hi[0] <= lo[0]) return;
-  const size_t len = (size_t)(hi[0] - lo[0]);
-  for (int k = lo[2]; k < hi[2]; ++k)
-    for (int j = lo[1]; j < hi[1]; ++j) {
-      const size_t first = (size_t)lo[0] + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * (size_t)k);
-      memset(g->fb + first * 2, 0, len * 2 * sizeof(double));
-    }
+void mpmc_grid_clear_fb_active(mpmc_grid *g) {
+  const long nrow = mpmc_grid_active_rows(g);
+  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
+  for (long r = 0; r < nrow; ++r)
+    memset(g->fb + mpmc_grid_active_row(g, r) * 2, 0, len * 2 * sizeof(double));
 }
 
 void mpmc_grid_free(mpmc_grid *g) {

@@ -103,12 +103,8 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar);
 void mpmc_grid_clear(mpmc_grid *g, int with_fbar);
 /* zero the active box only (the hot path: everything outside it is zero already) */
 void mpmc_grid_clear_active(mpmc_grid *g);
-/* The active box grown by one node per axis (within the grid): the nodes the stable form of
- * F-bar touches (its supports reach one node past the basis'); and zeroing its F-bar sums. */
-void mpmc_grid_fb_ring_box(const mpmc_grid *g, int lo[3], int hi[3]);
-void mpmc_grid_clear_fb_ring(mpmc_grid *g);
-/* zero the F-bar sums of the node box [lo, hi) */
-void mpmc_grid_clear_fb_box(mpmc_grid *g, const int lo[3], const int hi[3]);
+/* zero the F-bar sums of the active box (the F-bar projection's nodes, in every form) */
+void mpmc_grid_clear_fb_active(mpmc_grid *g);
 void mpmc_grid_free(mpmc_grid *g);
 /* The active box as rows of nodes along x: their number, and the first node of row r (each
  * row holds act_hi[0] - act_lo[0] consecutive nodes). */
