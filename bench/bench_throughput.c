@@ -2,11 +2,12 @@
  *   block  - a 3D elastic (Hencky) block, quadratic B-splines, F-bar off / on
  *   column - the 3D column collapse of issue 6: 2 x 0.5 x 1 m domain, h = 0.025 m, a 0.5 m
  *            cube of J2 soil with 2x2x2 points per cell (64,000 points), gravity
- * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale] [case] [threads] [shuffle];
+ * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale] [case] [threads] [shuffle] [sort];
  * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-8,
  * the rows of the table; -1 all) and threads (1 or 2; 0 both) narrow the run for profiling,
  * e.g. under callgrind; shuffle = 1 stores the points in random order (what sorting the
- * particle arrays by cell would undo: the cost of lost locality).  With MPMC_BENCH_CPU set in
+ * particle arrays by cell undoes: the cost of lost locality); sort = N sorts the points by cell
+ * every N steps (mpmc_sim_set_sort_interval; the first warm-up step sorts).  With MPMC_BENCH_CPU set in
  * the environment the rates are per second of the process's CPU time (all threads) instead
  * of wall-clock time: on a shared, loaded machine that is the steadier measure of the code's
  * cost. */
@@ -38,7 +39,7 @@ static double bytes_per_point(const mpmc_sim sim) {
   return b;
 }
 static double last_bytes;
-static int shuffle_points, use_cpu_time;
+static int shuffle_points, sort_every, use_cpu_time;
 
 static double now(void) {
   struct timespec ts;
@@ -95,6 +96,7 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
       }
     }
   }
+  CHECK(mpmc_sim_set_sort_interval(sim, sort_every));
   if (scene == 1) {
     const double g[3] = {0, 0, -9.81};
     CHECK(mpmc_sim_set_gravity(sim, g));
@@ -122,6 +124,7 @@ int main(int argc, char **argv) {
   const int only = argc > 3 ? atoi(argv[3]) : -1;
   const int nthr = argc > 4 ? atoi(argv[4]) : 0;
   shuffle_points = argc > 5 ? atoi(argv[5]) : 0;
+  sort_every = argc > 6 ? atoi(argv[6]) : 0;
   use_cpu_time = getenv("MPMC_BENCH_CPU") != NULL;
   const char *bn[4] = {"linear", "ugimp", "bspline2", "bspline3"};
   const char *fb[4] = {"off", "paper", "total", "stable"};

@@ -111,6 +111,7 @@ module mpmc
     mpmc_sim_set_rigid_velocity, mpmc_sim_get_rigid_offset, mpmc_sim_get_rigid_reaction, &
     mpmc_sim_get_rigid_gap, mpmc_sim_set_contact_params, mpmc_sim_get_contact_params
   public :: mpmc_sim_add_particles, mpmc_sim_get_num_particles, mpmc_sim_set_particle_forces
+  public :: mpmc_sim_set_sort_interval, mpmc_sim_get_sort_interval, mpmc_sim_sort_particles
   public :: mpmc_sim_add_wall, mpmc_sim_add_wall_face, mpmc_sim_add_wall_box, &
     mpmc_sim_add_wall_nodes, mpmc_sim_remove_wall
   public :: mpmc_sim_stable_dt, mpmc_sim_step, mpmc_sim_set_force_dt, mpmc_sim_get_time, &
@@ -121,7 +122,7 @@ module mpmc
   ! ---- public procedures: Fortran wrappers (strings, zero-copy arrays) -------------------
   public :: mpmc_error_string, mpmc_context_last_error, mpmc_context_get_last_error
   public :: mpmc_sim_get_field, mpmc_sim_restore_field, mpmc_sim_get_material_ids, &
-    mpmc_sim_get_user_state
+    mpmc_sim_get_particle_ids, mpmc_sim_get_user_state
   public :: mpmc_sim_add_particle_set, mpmc_sim_get_particle_set, mpmc_sim_find_particle_set
   public :: mpmc_sim_add_node_set, mpmc_sim_get_node_set, mpmc_sim_find_node_set
   public :: mpmc_output_create, mpmc_sim_checkpoint_write, mpmc_sim_checkpoint_read
@@ -281,6 +282,29 @@ module mpmc
       integer(c_int), value :: nthreads
       integer(c_int) :: ierr
     end function
+    !> Sort the points by grid cell every nsteps steps (0: never, the default): the arrays
+    !> are permuted in place, particle sets renumbered; mpmc_sim_get_particle_ids follows
+    !> each point.
+    function mpmc_sim_set_sort_interval(sim, nsteps) bind(C, name='mpmc_sim_set_sort_interval') &
+        result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: nsteps
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_sort_interval(sim, nsteps) bind(C, name='mpmc_sim_get_sort_interval') &
+        result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), intent(out) :: nsteps
+      integer(c_int) :: ierr
+    end function
+    !> Sort the points by grid cell now.
+    function mpmc_sim_sort_particles(sim) bind(C, name='mpmc_sim_sort_particles') result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int) :: ierr
+    end function
 
     ! ---- materials ------------------------------------------------------------------------
     function mpmc_sim_add_material_neo_hookean(sim, E, nu, rho, id) &
@@ -408,6 +432,13 @@ module mpmc
       integer(c_int) :: ierr
     end function
     function mpmc_sim_get_material_ids_c(sim, ids) bind(C, name='mpmc_sim_get_material_ids') &
+        result(ierr)
+      import :: c_int, c_ptr, mpmc_sim
+      type(mpmc_sim), value :: sim
+      type(c_ptr), intent(out) :: ids
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_particle_ids_c(sim, ids) bind(C, name='mpmc_sim_get_particle_ids') &
         result(ierr)
       import :: c_int, c_ptr, mpmc_sim
       type(mpmc_sim), value :: sim
@@ -906,6 +937,21 @@ contains
     if (ierr /= MPMC_SUCCESS) return
     if (c_associated(p)) call c_f_pointer(p, ids, [np])
   end function mpmc_sim_get_material_ids
+
+  !> Borrow the id of each point, ids(np): the 0-based index the point was added with (equal
+  !> to its index until a sort by cell moved it; read it, do not write).
+  function mpmc_sim_get_particle_ids(sim, ids) result(ierr)
+    type(mpmc_sim), intent(in) :: sim
+    integer(c_int), pointer, intent(out) :: ids(:)
+    integer(c_int) :: ierr, np
+    type(c_ptr) :: p
+    nullify (ids)
+    ierr = mpmc_sim_get_particle_ids_c(sim, p)
+    if (ierr /= MPMC_SUCCESS) return
+    ierr = mpmc_sim_get_num_particles(sim, np)
+    if (ierr /= MPMC_SUCCESS) return
+    if (c_associated(p)) call c_f_pointer(p, ids, [np])
+  end function mpmc_sim_get_particle_ids
 
   !> Borrow the user-material state without a copy: state(nstate, np), nstate the row
   !> length (the widest user material's); unassociated when no user material has state.

@@ -65,13 +65,16 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
     sc->metrics.toe = toe;
   }
   if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {
+    /* by id: the sort by cell (sort_interval) moves the point to other indices */
+    const int *ids;
+    if ((e = mpmc_sim_get_particle_ids(sim, &ids))) return e;
     double best = INFINITY;
     for (int q = 0; q < np; ++q) {
       double r2 = 0;
       for (int a = 0; a < d; ++a) r2 += pow(x0[(size_t)q * d + a] - m->point[a], 2);
       if (r2 < best) {
         best = r2;
-        sc->metrics.tip_index = q;
+        sc->metrics.tip_id = ids[q];
       }
     }
   }
@@ -95,7 +98,10 @@ int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *v) {
     v[WF_METRIC_RUNOUT] = fmax(0.0, front - m->toe);
   }
   if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {
-    const size_t q = (size_t)m->tip_index;
+    const int *ids;
+    if ((e = mpmc_sim_get_particle_ids(sim, &ids))) return e;
+    size_t q = 0;
+    while ((int)q < np - 1 && ids[q] != m->tip_id) ++q;
     v[WF_METRIC_TIP_X] = x[q * d] - x0[q * d];
     v[WF_METRIC_TIP_Y] = x[q * d + 1] - x0[q * d + 1];
   }

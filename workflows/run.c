@@ -151,6 +151,7 @@ static int build(wf_run *w) {
   WF_TRY(w, mpmc_sim_set_flip_blend(sim, sc->flip), "flip");
   WF_TRY(w, mpmc_sim_set_solver(sim, sc->solver), "solver");
   WF_TRY(w, mpmc_sim_set_threads(sim, sc->threads), "threads");
+  WF_TRY(w, mpmc_sim_set_sort_interval(sim, sc->sort_interval), "sort_interval");
   for (int i = 0; i < sc->nmat; ++i) {
     wf_material *m = &sc->mats[i];
     int e = 0;
@@ -590,6 +591,9 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
   int kern = MPMC_KERNELS_BASELINE;
   mpmc_sim_get_kernels(w->sim, &kern);
   fprintf(f, "  \"kernels\": \"%s\",\n", kern == MPMC_KERNELS_AVX2 ? "avx2" : "baseline");
+  int sort_every = 0;
+  mpmc_sim_get_sort_interval(w->sim, &sort_every);
+  fprintf(f, "  \"sort_interval\": %d,\n", sort_every);
   fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
   fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
           st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);

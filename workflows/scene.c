@@ -1163,7 +1163,7 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   static const char *const keys[] = {"scene", "description", "dim", "geometry", "grid", "basis", "fbar",
                                      "flip", "solver", "threads", "materials", "stages", "metrics",
                                      "plots", "checkpoint_interval", "progress_interval", "rigid_bodies",
-                                     "contact", "snapshot_plots", NULL};
+                                     "contact", "snapshot_plots", "sort_interval", NULL};
   if (check_map(r, root, "", keys)) return -1;
   char def[WF_NAME];
   const char *base = strrchr(sc->path, '/');
@@ -1211,6 +1211,7 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   if (get_num(r, root, "", "flip", 0, 1.0, UNIT, &sc->flip)) return -1;
   if (get_enum(r, root, "", "solver", 0, MPMC_SOLVER_AUTO, solver_words, &sc->solver)) return -1;
   if (get_int(r, root, "", "threads", 0, 0, 0, 1024, &sc->threads)) return -1;
+  if (get_int(r, root, "", "sort_interval", 0, 100, 0, 1000000000, &sc->sort_interval)) return -1;
   if (get_bool(r, root, "", "plots", 1, &sc->plots)) return -1;
   if (get_num(r, root, "", "checkpoint_interval", 0, 300, POS, &sc->checkpoint_interval)) return -1;
   if (get_num(r, root, "", "progress_interval", 0, 5, POS, &sc->progress_interval)) return -1;

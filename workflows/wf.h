@@ -129,7 +129,7 @@ typedef struct {
   double toe;                /* runout: initial toe abscissa                        */
   int runout_axis;
   double point[3];           /* tip displacement: the point whose motion is tracked */
-  int tip_index;             /* the nearest material point (set at run time)        */
+  int tip_id;                /* id of the nearest material point (set at run time)  */
   /* bearing_capacity_ratio (rigid.c, docs/contact.md): body, footing width B for delta/B,
    * the width the modelled reaction acts on (B/2 in a half model), su, the load axis, and
    * the window: mean q/su over settlements from `from` x the final settlement on */
@@ -161,6 +161,7 @@ typedef struct {
   char name[WF_NAME];
   int dim;
   int basis, fbar, solver, threads;
+  int sort_interval;        /* steps between sorts of the points by cell; 0: never */
   double flip;
   double lo[3], hi[3], h;
   int nmat;

@@ -177,6 +177,16 @@ int mpmc_sim_get_num_particles(const mpmc_sim sim, int *n);
 int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp);
 int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data);
 int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids);
+/* Sorting the points by grid cell for locality (the transfers' caches): off by default, so
+ * a point keeps the index it was added with.  With nsteps > 0 the step sorts every nsteps
+ * steps (the first step too): every per-point array moves, particle sets are renumbered, and
+ * ids[i] (get_particle_ids) is the index point i had when it was added, to follow a point.
+ * Field pointers stay valid (the arrays are permuted in place).  Results change only by the
+ * summation order at the nodes; the sort does not depend on the thread count. */
+int mpmc_sim_set_sort_interval(mpmc_sim sim, int nsteps);
+int mpmc_sim_get_sort_interval(const mpmc_sim sim, int *nsteps);
+int mpmc_sim_sort_particles(mpmc_sim sim); /* sort now */
+int mpmc_sim_get_particle_ids(mpmc_sim sim, const int **ids);
 /* External force on points [first, first+n): f[n*dim] (a traction times its tributary
  * length or area).  Allocates the force field on first use. */
 int mpmc_sim_set_particle_forces(mpmc_sim sim, int first, int n, const double *f);

@@ -70,6 +70,8 @@ static int write_config(hid_t f, const mpmc_sim sim) {
                            stats);
   st |= mpmc_h5_attr_write(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1,
                            &sim->stats.wall_seconds);
+  const int64_t sort[2] = {sim->sort_every, sim->sort_last}; /* interval, step of the last */
+  st |= mpmc_h5_attr_write(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
   H5Gclose(g);
   return st < 0 ? -1 : 0;
 }
@@ -94,6 +96,9 @@ static int read_config(hid_t f, mpmc_sim sim) {
   st |= mpmc_h5_attr_read(g, "stats_steps_particlesteps_returnmaps_kinsol", H5T_NATIVE_INT64, 4,
                           stats);
   st |= mpmc_h5_attr_read(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1, &wall);
+  int64_t sort[2] = {0, -1}; /* absent in files of before the sort: never sorted */
+  if (H5Aexists(g, "sort_interval_last") > 0)
+    st |= mpmc_h5_attr_read(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
   H5Gclose(g);
   MPMC_CHECK(st >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint /config: missing or malformed attributes");
   MPMC_CHECK(ints[0] == sim->dim, ctx, MPMC_ERR_FORMAT,
@@ -117,6 +122,11 @@ static int read_config(hid_t f, mpmc_sim sim) {
   sim->stats.return_maps = stats[2];
   sim->stats.kinsol_fallbacks = stats[3];
   sim->stats.wall_seconds = wall;
+  MPMC_CHECK(sort[0] >= 0 && sort[0] <= INT32_MAX && sort[1] >= -1 && sort[1] <= stats[0], ctx,
+             MPMC_ERR_FORMAT, "checkpoint /config: bad sort_interval_last = [%lld, %lld]",
+             (long long)sort[0], (long long)sort[1]);
+  sim->sort_every = (int)sort[0];
+  sim->sort_last = sort[1];
   return MPMC_SUCCESS;
 }
 
@@ -276,6 +286,8 @@ static int write_particles(hid_t f, const mpmc_sim sim) {
   }
   if (st >= 0)
     st |= mpmc_h5_dataset_write(g, "mat", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)p->n, 0, p->mat);
+  if (st >= 0 && p->id) /* the points' ids once a sort has moved them (sort.c) */
+    st |= mpmc_h5_dataset_write(g, "id", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)p->n, 0, p->id);
   H5Gclose(g);
   return st < 0 ? -1 : 0;
 }
@@ -319,6 +331,23 @@ static int read_particles(hid_t f, mpmc_sim sim) {
     if (p->mat[q] < 0 || p->mat[q] >= sim->nmat)
       err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint point %d: material id %d of %d", q,
                        p->mat[q], sim->nmat);
+  if (!err && exists(g, "id")) {
+    p->id = malloc(sizeof(int) * (size_t)p->cap);
+    if (!p->id || read_dataset(g, "id", H5T_NATIVE_INT, (size_t)n, 0, p->id) < 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles/id: unreadable or not [%d]", n);
+    /* a permutation of 0 .. n-1: each id once */
+    unsigned char *seen = err ? NULL : calloc((size_t)n + 1, 1);
+    if (!err && !seen) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "checkpoint: out of memory");
+    for (int q = 0; q < n && !err; ++q) {
+      if (p->id[q] < 0 || p->id[q] >= n || seen[p->id[q]])
+        err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
+                         "checkpoint /particles/id: point %d has id %d (not a permutation of 0 .. %d)",
+                         q, p->id[q], n - 1);
+      else
+        seen[p->id[q]] = 1;
+    }
+    free(seen);
+  }
   H5Gclose(g);
   return err;
 }

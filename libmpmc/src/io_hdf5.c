@@ -252,6 +252,10 @@ static int write_snapshot(mpmc_output out, hid_t g, mpmc_snap *s, double *buf,
   }
   st |= mpmc_h5_dataset_write(g, "material", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)n, 0, p->mat);
   MPMC_CALL(note_field(ctx, s, "material", 1, 1));
+  if (p->id) { /* once the points are sorted by cell (sort.c), each point's id to follow it */
+    st |= mpmc_h5_dataset_write(g, "id", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)n, 0, p->id);
+    MPMC_CALL(note_field(ctx, s, "id", 1, 1));
+  }
   /* set membership, one 0/1 array per set */
   const int nset = sim->sets ? sim->sets->n : 0;
   for (int k = 0; k < nset; ++k) {
@@ -272,7 +276,9 @@ static int write_snapshot(mpmc_output out, hid_t g, mpmc_snap *s, double *buf,
 /**
  * @brief Append one snapshot at the current time: position and velocity (padded to 3
  *        components in 2D), stress (Voigt xx yy zz yz xz xy), mean_stress, J, and where the
- *        scene has them Jbar, eps_p; mass, material id and set_<name> membership (0/1).
+ *        scene has them Jbar, eps_p; mass, material id, id (the point's index when added,
+ *        once the points are sorted: mpmc_sim_set_sort_interval) and set_<name> membership
+ *        (0/1).
  *        The group carries the attributes time and step.  The XDMF file is then rewritten.
  */
 int mpmc_output_write(mpmc_output out) {
@@ -284,6 +290,10 @@ int mpmc_output_write(mpmc_output out) {
   /* allocate the fields the scene will have from its first step on, so that every snapshot
    * lists the same fields */
   MPMC_CALL(mpmc_sim_prepare(sim));
+  if (sim->sort_every > 0) { /* the ids, which the first sort would create */
+    const int *ids;
+    MPMC_CALL(mpmc_sim_get_particle_ids(sim, &ids));
+  }
   if (out->nsnap == out->capsnap) {
     const int cap = out->capsnap ? 2 * out->capsnap : 16;
     mpmc_snap *a = realloc(out->snaps, sizeof *a * (size_t)cap);

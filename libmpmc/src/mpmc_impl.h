@@ -58,6 +58,8 @@ typedef struct {
   double *cforce;/* [n][dim] contact force from rigid bodies (contact_barrier.c)   */
   double *ustate;/* [n][nustate] state of user materials (material_user.c)        */
   int nustate;
+  int *id;       /* [n] the index each point had when added (allocated by the first sort or
+                    mpmc_sim_get_particle_ids; NULL: ids are the indices) (sort.c)      */
   /* step scratch */
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
   double *xn;    /* [n][dim] new positions while F-bar still needs the old ones    */
@@ -236,6 +238,8 @@ struct mpmc_sim_s {
   struct mpmc_sets_s *node_sets; /* named grid node sets (sets.c)                     */
   mpmc_monitor monitor;         /* energy check after each step (monitor.c)           */
   int kernels;                  /* kernel set in use: MPMC_KERNELS_BASELINE or _AVX2   */
+  int sort_every;               /* sort the points by cell every this many steps; 0: never */
+  int64_t sort_last;            /* step count at the last sort; -1: none yet (sort.c)   */
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),
@@ -267,6 +271,9 @@ MPMC_KERNEL_PROTOTYPES(_avx2)
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
 /* 1 if this build carries the AVX2 kernels and the processor (and OS) runs them (sim.c) */
 int mpmc_kernels_avx2_available(void);
+
+/* sort.c: before a step, sort the points by cell if the sort interval has passed */
+int mpmc_sort_due(struct mpmc_sim_s *sim);
 
 /* helpers shared between files */
 int mpmc_sim_prepare(struct mpmc_sim_s *sim);

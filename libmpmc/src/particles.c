@@ -30,6 +30,11 @@ int mpmc_particles_reserve(mpmc_context ctx, mpmc_particles *p, int cap) {
   int *mat = realloc(p->mat, sizeof(int) * (size_t)cap);
   MPMC_CHECK(mat, ctx, MPMC_ERR_MEMORY, "cannot grow the material ids to %d points", cap);
   p->mat = mat;
+  if (p->id) {
+    int *id = realloc(p->id, sizeof(int) * (size_t)cap);
+    MPMC_CHECK(id, ctx, MPMC_ERR_MEMORY, "cannot grow the point ids to %d points", cap);
+    p->id = id;
+  }
   MPMC_CALL(grow(ctx, &p->Jbar, 1, cap));
   MPMC_CALL(grow(ctx, &p->be, 6, cap));
   MPMC_CALL(grow(ctx, &p->eps_p, 1, cap));
@@ -63,5 +68,7 @@ void mpmc_particles_free(mpmc_particles *p) {
   }
   free(p->mat);
   p->mat = NULL;
+  free(p->id);
+  p->id = NULL;
   p->n = p->cap = p->nustate = 0;
 }

@@ -74,6 +74,7 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
   s->basis = MPMC_BASIS_BSPLINE2;
   s->flip = 1.0;
   s->solver = MPMC_SOLVER_AUTO;
+  s->sort_last = -1;
   s->p.dim = dim;
   const int err = kernels_from_env(s);
   if (err) {
@@ -303,6 +304,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
     p->J[q] = 1.0;
     for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
     p->mat[q] = material;
+    if (p->id) p->id[q] = (int)q; /* a point's id is its index when added */
     if (p->Jbar) p->Jbar[q] = 1.0;
     if (p->be)
       for (int k = 0; k < 6; ++k) p->be[q * 6 + k] = k < 3 ? 1.0 : 0.0;

@@ -69,6 +69,7 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
                        dt, limit, sim->grid.h, limit);
   }
   const double t0 = now();
+  if (!err) err = mpmc_sort_due(sim); /* locality: points by cell (sort.c), if asked for */
   if (!err) err = step_phases(sim, dt);
 #ifdef _OPENMP
   if (sim->nthreads > 0) omp_set_num_threads(saved);
