@@ -160,36 +160,13 @@ static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) 
   MPMC_CALL(mpmc_rm_sim_workspaces(sim, nthreads, &ws));
   int64_t nret = 0, nfb = 0;
   int first_bad = INT_MAX;
-  /* threads only pay off beyond a few hundred points (a parallel region costs ~us, far
-     more when the cores are shared) */
-#pragma omp parallel if (p->n >= 256) reduction(+ : nret, nfb) reduction(min : first_bad)
-  {
-    int tid = 0;
-#ifdef _OPENMP
-    tid = omp_get_thread_num();
+  /* the points in blocks of four (stress_j2.c), in the sim's instruction set */
+#ifdef MPMC_HAVE_AVX2_KERNELS
+  if (sim->kernels == MPMC_KERNELS_AVX2)
+    MPMC_CALL(mpmc_j2_batch_avx2(sim, mat, id, ws, &nret, &nfb, &first_bad));
+  else
 #endif
-    mpmc_rm_ws *w = ws[tid];
-#pragma omp for schedule(static)
-    for (int q = 0; q < p->n; ++q) {
-      if (p->mat[q] != id) continue;
-      double F3[3][3], tau[6], J;
-      mpmc_j2_info info = {0};
-      /* 3D: dF is already a row-major 3x3 */
-      double(*F)[3] = d == 3 ? (double(*)[3])(p->dF + (size_t)q * 9) : F3;
-      if (d != 3) mpmc_embed(d, p->dF + (size_t)q * d * d, F3);
-      const int err = return_map_point(w, solver, &par, F, p->be + (size_t)q * 6, p->eps_p + q,
-                                       tau, &J, &info);
-      if (err) {
-        if (q < first_bad) first_bad = q;
-        continue;
-      }
-      nret += info.plastic;
-      nfb += info.fallback;
-      double *sg = p->stress + (size_t)q * 6;
-      const double inv_J = 1.0 / J;
-      for (int k = 0; k < 6; ++k) sg[k] = tau[k] * inv_J;
-    }
-  }
+    MPMC_CALL(mpmc_j2_batch(sim, mat, id, ws, &nret, &nfb, &first_bad));
   sim->stats.return_maps += nret;
   sim->stats.kinsol_fallbacks += nfb;
   if (first_bad == INT_MAX) return MPMC_SUCCESS;

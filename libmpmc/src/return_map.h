@@ -81,4 +81,15 @@ int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, d
  * at least nthreads and returns them; freed by mpmc_return_map_free. */
 int mpmc_rm_sim_workspaces(struct mpmc_sim_s *sim, int nthreads, mpmc_rm_ws ***ws);
 
+/* stress_j2.c, one of the kernel files (mpmc_impl.h): the stress update of material id's
+ * points, elastic ones four at a time, the others by mpmc_j2_return_map; counts of plastic
+ * corrections and KINSOL fallbacks, and the lowest failed point (INT_MAX: none). */
+#define MPMC_J2_BATCH_PROTOTYPE(S)                                                            \
+  int mpmc_j2_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,               \
+                       mpmc_rm_ws **ws, int64_t *nret, int64_t *nfb, int *first_bad);
+MPMC_J2_BATCH_PROTOTYPE()
+#if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2)
+MPMC_J2_BATCH_PROTOTYPE(_avx2)
+#endif
+
 #endif

@@ -1,0 +1,195 @@
+/* The Hencky-J2 stress update over blocks of four points (issue 6: "materials called over
+ * batches"), one of the kernel files compiled for baseline x86-64 and for AVX2
+ * (mpmc_impl.h, MPMC_ISA).
+ *
+ * Most points of a slope or a column are elastic in a given step: their trial state
+ * b = dF b_e dF^T, its Hencky strain by the series of linalg.h (mpmc_sym3_log_series), the
+ * trial von Mises stress and the check against kappa(eps_p) are the same arithmetic for
+ * every point, so four neighbouring points go through them at once in vectors of four
+ * doubles (one AVX2 register, two SSE2 ones).  The series takes the degree the largest
+ * strain of the four needs (the terms beyond a point's own degree are below its 2^-54
+ * tolerance).  A point that turns out plastic, or whose strain is too large for the series,
+ * is handed to the scalar return map (material_hencky_j2.c, mpmc_j2_return_map) from its
+ * unchanged inputs; points of other materials in a block are masked out.  The blocks are
+ * fixed by the point index (points 4k .. 4k+3), so the results do not depend on the thread
+ * count, and the two instruction sets give the same bits (ISO C: no contraction). */
+#include <limits.h>
+#include <math.h>
+#include <stdint.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "linalg.h"
+#include "return_map.h"
+
+typedef double v4 __attribute__((vector_size(4 * sizeof(double))));
+
+/* c = a b for symmetric a, b (Voigt) that commute, as mpmc_sym3_mul */
+static inline void sym_mul4(const v4 *a, const v4 *b, v4 *c) {
+  const v4 xx = a[0] * b[0] + a[5] * b[5] + a[4] * b[4];
+  const v4 yy = a[5] * b[5] + a[1] * b[1] + a[3] * b[3];
+  const v4 zz = a[4] * b[4] + a[3] * b[3] + a[2] * b[2];
+  const v4 yz = a[5] * b[4] + a[1] * b[3] + a[3] * b[2];
+  const v4 xz = a[0] * b[4] + a[5] * b[3] + a[4] * b[2];
+  const v4 xy = a[0] * b[5] + a[5] * b[1] + a[4] * b[3];
+  c[0] = xx, c[1] = yy, c[2] = zz, c[3] = yz, c[4] = xz, c[5] = xy;
+}
+
+/* |s|^2 (Voigt, tensor shear components), as mpmc_sym3_norm2 (through a pointer: a v4
+ * returned by value would change the baseline build's ABI) */
+static inline void norm2_4(const v4 *s, v4 *r) {
+  *r = s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
+}
+
+/* The block's trial Hencky strain eps = 1/2 ln b by linalg.h's series (same tables and
+ * Horner scheme), at the degree the largest active lane needs.  fail[l] = 1 for a lane
+ * whose strain the series cannot take (|Z|^2 above the table, or not finite). */
+static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) {
+  static const double rho2_max[11] = {0.0,       1.665e-16, 1.666e-08, 7.297e-06,
+                                      1.4949e-04, 9.0589e-04, 2.9934e-03, 7.0039e-03,
+                                      1.3216e-02, 2.1619e-02, 3.2007e-02};
+  static const double c[10] = {1.0,       1.0 / 3.0,  1.0 / 5.0,  1.0 / 7.0,  1.0 / 9.0,
+                               1.0 / 11.0, 1.0 / 13.0, 1.0 / 15.0, 1.0 / 17.0, 1.0 / 19.0};
+  const v4 a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
+  const v4 m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
+  const v4 adj[6] = {m[1] * m[2] - m[3] * m[3], m[0] * m[2] - m[4] * m[4],
+                     m[0] * m[1] - m[5] * m[5], m[4] * m[5] - m[0] * m[3],
+                     m[5] * m[3] - m[1] * m[4], m[4] * m[3] - m[2] * m[5]};
+  const v4 det = m[0] * adj[0] + m[5] * adj[5] + m[4] * adj[4];
+  v4 z[6], w[6], p[6];
+  sym_mul4(a, adj, z);
+  const v4 inv_det = 1.0 / det;
+  for (int k = 0; k < 6; ++k) z[k] *= inv_det;
+  v4 r2;
+  norm2_4(z, &r2);
+  int n = 1;
+  for (int l = 0; l < 4; ++l) {
+    fail[l] = 0;
+    if (!act[l]) continue;
+    if (!(r2[l] <= rho2_max[10])) {
+      fail[l] = 1;
+      continue;
+    }
+    while (r2[l] > rho2_max[n]) ++n;
+  }
+  if (n == 1) {
+    for (int k = 0; k < 6; ++k) eps[k] = z[k];
+    return;
+  }
+  sym_mul4(z, z, w);
+  for (int k = 0; k < 6; ++k) p[k] = c[n - 1] * w[k];
+  for (int k = 0; k < 3; ++k) p[k] += c[n - 2];
+  for (int j = n - 3; j >= 0; --j) {
+    sym_mul4(w, p, p);
+    for (int k = 0; k < 3; ++k) p[k] += c[j];
+  }
+  sym_mul4(z, p, eps);
+}
+
+/**
+ * Update the stress of every point of material id (F-bar scaled dF in p->dF): elastic
+ * points in blocks of four, the others by the scalar return map.  *nret and *nfb count the
+ * plastic corrections and KINSOL fallbacks; *first_bad is the lowest failed point (INT_MAX
+ * for none), left unchanged for material_hencky_j2.c to report.
+ */
+int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
+                            mpmc_rm_ws **ws, int64_t *nret_out, int64_t *nfb_out,
+                            int *first_bad_out) {
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim, solver = sim->solver, n = p->n;
+  const mpmc_j2_param par = {mat->K, mat->G, mat->kappa_p, mat->kappa_r, mat->eta};
+  const double G2 = 2.0 * par.G, K = par.K;
+  const int nblk = (n + 3) / 4;
+  int64_t nret = 0, nfb = 0;
+  int first_bad = INT_MAX;
+  /* threads only pay off beyond a few hundred points (a parallel region costs ~us, far
+     more when the cores are shared) */
+#pragma omp parallel if (n >= 256) reduction(+ : nret, nfb) reduction(min : first_bad)
+  {
+    int tid = 0;
+#ifdef _OPENMP
+    tid = omp_get_thread_num();
+#endif
+    mpmc_rm_ws *w = ws[tid];
+#pragma omp for schedule(static)
+    for (int blk = 0; blk < nblk; ++blk) {
+      const int q0 = 4 * blk;
+      int act[4], nact = 0;
+      v4 F[9], b[6];
+      for (int l = 0; l < 4; ++l) {
+        const int q = q0 + l;
+        act[l] = q < n && p->mat[q] == id;
+        nact += act[l];
+        if (act[l]) {
+          const double *f = p->dF + (size_t)q * d * d, *be = p->be + (size_t)q * 6;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) F[3 * i + j][l] = (i < d && j < d) ? f[i * d + j] : (i == j);
+          for (int k = 0; k < 6; ++k) b[k][l] = be[k];
+        } else { /* identity: a finite, elastic dummy */
+          for (int k = 0; k < 9; ++k) F[k][l] = (k % 4 == 0);
+          for (int k = 0; k < 6; ++k) b[k][l] = k < 3;
+        }
+      }
+      if (!nact) continue;
+      /* trial b = F b_e F^T (mpmc_push_forward's order): T = F B, then T F^T's upper half */
+      const v4 B[3][3] = {{b[0], b[5], b[4]}, {b[5], b[1], b[3]}, {b[4], b[3], b[2]}};
+      v4 T[3][3];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          T[i][j] = F[3 * i] * B[0][j] + F[3 * i + 1] * B[1][j] + F[3 * i + 2] * B[2][j];
+      v4 bt[6];
+      static const int vi[6] = {0, 1, 2, 1, 0, 0}, vj[6] = {0, 1, 2, 2, 2, 1};
+      for (int k = 0; k < 6; ++k) {
+        const int i = vi[k], j = vj[k];
+        bt[k] = T[i][0] * F[3 * j] + T[i][1] * F[3 * j + 1] + T[i][2] * F[3 * j + 2];
+      }
+      v4 eps[6], e[6];
+      int fail[4];
+      log_series4(bt, act, eps, fail);
+      const v4 tr = eps[0] + eps[1] + eps[2];
+      for (int k = 0; k < 6; ++k) e[k] = eps[k];
+      for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
+      v4 q2;
+      norm2_4(e, &q2);
+      q2 *= 1.5;
+      /* J = sqrt(det b) = exp(tr eps), without the exp */
+      const v4 detb = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
+                      bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
+      for (int l = 0; l < 4; ++l) {
+        if (!act[l]) continue;
+        const int q = q0 + l;
+        double *ep = p->eps_p + q;
+        const double x = par.eta * *ep;
+        const double k0 = par.kappa_r + (par.kappa_p - par.kappa_r) * (x == 0.0 ? 1.0 : exp(-x));
+        const double qtr = sqrt(q2[l]) * G2;
+        double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
+        if (!fail[l] && qtr <= k0 && detb[l] > 0.0) { /* elastic: b_e = trial b */
+          const double inv_J = 1.0 / sqrt(detb[l]);
+          for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
+          for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
+          continue;
+        }
+        /* plastic, outside the series, or not finite: the scalar return map from the
+         * unchanged b_e^n and dF */
+        double Fl[3][3], tau[6], J;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) Fl[i][j] = F[3 * i + j][l];
+        mpmc_j2_info info = {0};
+        const int err = mpmc_j2_return_map(w, solver, &par, Fl, be, ep, tau, &J, &info);
+        if (err) {
+          if (q < first_bad) first_bad = q;
+          continue;
+        }
+        nret += info.plastic;
+        nfb += info.fallback;
+        const double inv_J = 1.0 / J;
+        for (int k = 0; k < 6; ++k) sg[k] = tau[k] * inv_J;
+      }
+    }
+  }
+  *nret_out = nret;
+  *nfb_out = nfb;
+  *first_bad_out = first_bad;
+  return MPMC_SUCCESS;
+}

@@ -1,0 +1,180 @@
+/* The Hencky-J2 stress update over blocks of four points (stress_j2.c) against the scalar
+ * return map of each point (mpmc_j2_return_map): 2D and 3D, a point count that leaves a
+ * partial last block, two J2 materials and a Hencky one interleaved (masked lanes), elastic
+ * points of strains from 1e-9 to past the series' range (the eigen fallback), plastic
+ * points with and without softening history; b_e, eps_p and the stress agree to 1e-12, the
+ * counts of plastic corrections match, both instruction sets give the same bits, and a point
+ * with a non-finite dF fails the update with its own index in the message. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "linalg.h"
+#include "mpmc_impl.h"
+#include "return_map.h"
+#include "test_util.h"
+
+#define TEST_RNG_SEED 0x2545F4914F6CDD1Dull
+#include "test_rand.h"
+
+#define NP 103
+
+typedef struct {
+  double be[6 * NP], eps_p[NP], stress[6 * NP];
+  int64_t plastic;
+} state;
+
+static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
+  mpmc_sim sim;
+  TCALL(mpmc_sim_create(ctx, dim, &sim));
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
+  TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e7, 0.3, 2000, 3e4, 5e3, 8, &mats[0]));
+  TCALL(mpmc_sim_add_material_hencky_j2(sim, 5e7, 0.49, 1800, 2e5, 2e5, 0, &mats[1]));
+  TCALL(mpmc_sim_add_material_hencky(sim, 1e7, 0.3, 2000, &mats[2]));
+  for (int q = 0; q < NP; ++q) {
+    const double x[3] = {0.3 + 0.004 * q, 0.5, 0.5}, v = 1e-4;
+    /* J2 A mostly, J2 B every third point, Hencky every seventh: blocks mix materials */
+    const int m = q % 7 == 3 ? mats[2] : q % 3 == 1 ? mats[1] : mats[0];
+    TCALL(mpmc_sim_add_particles(sim, 1, x, &v, m, NULL));
+  }
+  TCALL(mpmc_sim_prepare(sim));
+  return sim;
+}
+
+/* random inputs: b_e^n SPD (some far from I), eps_p, dF of strain magnitudes 1e-9 .. 0.3 */
+static void fill(mpmc_sim sim) {
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  for (int q = 0; q < NP; ++q) {
+    double R[3][3], A[3][3], lam[3];
+    rand_rotation(R);
+    if (d == 2) { /* plane strain: b_e keeps yz = xz = 0, a rotation about z */
+      const double t = 2.0 * M_PI * urand();
+      const double R2[3][3] = {{cos(t), -sin(t), 0}, {sin(t), cos(t), 0}, {0, 0, 1}};
+      memcpy(R, R2, sizeof R);
+    }
+    /* a few beyond the series (|eps| > 0.18), half of the rest inside the yield surface */
+    const double big = q % 11 == 5 ? 0.4 : q % 2 ? 0.001 : 0.02;
+    for (int a = 0; a < 3; ++a) lam[a] = exp(2.0 * big * (2.0 * urand() - 1.0));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        A[i][j] = 0;
+        for (int a = 0; a < 3; ++a) A[i][j] += R[i][a] * lam[a] * R[j][a];
+      }
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j) p->be[q * 6 + mpmc_voigt(i, j)] = A[i][j];
+    p->eps_p[q] = q % 4 == 0 ? 0.0 : loguni(1e-6, 0.5);
+    const double s = loguni(1e-9, 0.01);
+    for (int i = 0; i < d; ++i)
+      for (int j = 0; j < d; ++j) p->dF[q * d * d + i * d + j] = (i == j) + s * (2.0 * urand() - 1.0);
+    for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
+  }
+}
+
+static void save(const mpmc_sim sim, state *s) {
+  memcpy(s->be, sim->p.be, sizeof s->be);
+  memcpy(s->eps_p, sim->p.eps_p, sizeof s->eps_p);
+  memcpy(s->stress, sim->p.stress, sizeof s->stress);
+  s->plastic = sim->stats.return_maps;
+}
+
+static void run_dim(int dim) {
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  int mats[3];
+  mpmc_sim sim = make(ctx, dim, mats);
+  mpmc_particles *p = &sim->p;
+  fill(sim);
+  double be0[6 * NP], ep0[NP], dF0[9 * NP];
+  memcpy(be0, p->be, sizeof be0);
+  memcpy(ep0, p->eps_p, sizeof ep0);
+  memcpy(dF0, p->dF, sizeof(double) * NP * dim * dim);
+  /* the expected state, point by point by the scalar return map */
+  state want = {0};
+  int plastic = 0, series_out = 0;
+  for (int q = 0; q < NP; ++q) {
+    memcpy(want.be + 6 * q, be0 + 6 * q, sizeof(double) * 6);
+    want.eps_p[q] = ep0[q];
+    if (p->mat[q] == mats[2]) continue; /* Hencky: not this update's */
+    const mpmc_material *m = &sim->mats[p->mat[q]];
+    const mpmc_j2_param par = {m->K, m->G, m->kappa_p, m->kappa_r, m->eta};
+    double F[3][3], tau[6], J;
+    mpmc_embed(dim, dF0 + q * dim * dim, F);
+    mpmc_j2_info info = {0};
+    TCALL(mpmc_j2_return_map(NULL, MPMC_SOLVER_NEWTON, &par, F, want.be + 6 * q, want.eps_p + q, tau,
+                             &J, &info));
+    for (int k = 0; k < 6; ++k) want.stress[6 * q + k] = tau[k] / J;
+    plastic += info.plastic;
+    double b[6], eps[6];
+    memcpy(b, be0 + 6 * q, sizeof b);
+    mpmc_push_forward(F, b);
+    series_out += mpmc_sym3_log_series(b, eps);
+  }
+  if (plastic < 10 || NP - plastic < 30 || series_out < 3)
+    fail_msg("dim %d: weak mix: %d plastic, %d outside the series", dim, plastic, series_out);
+  TCALL(mpmc_sim_set_solver(sim, MPMC_SOLVER_NEWTON));
+  state got[2];
+  const int sets[2] = {MPMC_KERNELS_BASELINE, MPMC_KERNELS_AVX2};
+  int nsets = 0;
+  for (int s = 0; s < 2; ++s) {
+    if (mpmc_sim_set_kernels(sim, sets[s])) { /* no AVX2 here */
+      mpmc_context_clear_error(ctx);
+      continue;
+    }
+    memcpy(p->be, be0, sizeof be0);
+    memcpy(p->eps_p, ep0, sizeof ep0);
+    memcpy(p->dF, dF0, sizeof(double) * NP * dim * dim);
+    for (int k = 0; k < 6 * NP; ++k) p->stress[k] = 0.0;
+    const int64_t before = sim->stats.return_maps;
+    for (int m = 0; m < 2; ++m) TCALL(sim->mats[mats[m]].ops->stress_update(sim, &sim->mats[mats[m]], mats[m], 1e-3));
+    save(sim, &got[nsets]);
+    got[nsets].plastic -= before;
+    const state *g = &got[nsets++];
+    if (g->plastic != plastic) fail_msg("dim %d, set %d: %lld plastic corrections, expected %d", dim, sets[s], (long long)g->plastic, plastic);
+    for (int q = 0; q < NP; ++q) {
+      double smax = 0;
+      for (int k = 0; k < 6; ++k) smax = fmax(smax, fabs(want.stress[6 * q + k]));
+      for (int k = 0; k < 6; ++k) {
+        if (!(fabs(g->be[6 * q + k] - want.be[6 * q + k]) <= 1e-12))
+          fail_msg("dim %d point %d (material %d): be[%d] %.17g, scalar %.17g", dim, q, p->mat[q], k, g->be[6 * q + k], want.be[6 * q + k]);
+        if (!(fabs(g->stress[6 * q + k] - want.stress[6 * q + k]) <= 1e-12 * smax + 1e-300))
+          fail_msg("dim %d point %d (material %d): stress[%d] %.17g, scalar %.17g", dim, q, p->mat[q], k, g->stress[6 * q + k], want.stress[6 * q + k]);
+      }
+      if (!(fabs(g->eps_p[q] - want.eps_p[q]) <= 1e-12 * fmax(1.0, want.eps_p[q])))
+        fail_msg("dim %d point %d: eps_p %.17g, scalar %.17g", dim, q, g->eps_p[q], want.eps_p[q]);
+    }
+  }
+  if (nsets == 2 && (memcmp(got[0].be, got[1].be, sizeof got[0].be) || memcmp(got[0].stress, got[1].stress, sizeof got[0].stress) ||
+                     memcmp(got[0].eps_p, got[1].eps_p, sizeof got[0].eps_p)))
+    fail_msg("dim %d: baseline and AVX2 stress updates differ", dim);
+  /* a non-finite dF in the middle of a block: the error names the point */
+  memcpy(p->be, be0, sizeof be0);
+  memcpy(p->eps_p, ep0, sizeof ep0);
+  memcpy(p->dF, dF0, sizeof(double) * NP * dim * dim);
+  const int bad = 57; /* material J2 A (57 % 3 = 0, 57 % 7 = 1) */
+  if (p->mat[bad] != mats[0]) fail_msg("test set-up: point %d is not of material 0", bad);
+  p->dF[bad * dim * dim] = NAN;
+  const int e = sim->mats[mats[0]].ops->stress_update(sim, &sim->mats[mats[0]], mats[0], 1e-3);
+  char want_msg[64];
+  snprintf(want_msg, sizeof want_msg, "point %d at", bad);
+  if (e == MPMC_SUCCESS || !strstr(mpmc_context_last_error(ctx), want_msg))
+    fail_msg("dim %d: non-finite point %d: code %d, '%s'", dim, bad, e, mpmc_context_last_error(ctx));
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+}
+
+static void test_batch_equals_scalar(void **state) {
+  (void)state;
+  run_dim(3);
+  run_dim(2);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {cmocka_unit_test(test_batch_equals_scalar)};
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
