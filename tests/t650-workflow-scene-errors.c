@@ -160,6 +160,14 @@ static void test_bad_override(void **state) {
   const char *ok[] = {"fbar=stable", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-fbar-stable", 2, ok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
   if (e != 0) fail_msg("--set fbar=stable: expected success, got %d: %s", e, msg);
+  const char *srt[] = {"sort_interval=-1"};
+  e = run_lib(scene, DIR "/out-override", 1, srt, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set sort_interval=-1: expected a failure, got 0");
+  expect_in("--set sort_interval", msg, "key 'sort_interval': must be in [0, 1e+09] (got -1)");
+  /* an empty list of snapshot plots is none, not an error; sorting every step runs */
+  const char *none[] = {"snapshot_plots=[]", "sort_interval=1", "stages.0.end.time=0.0005"};
+  e = run_lib(scene, DIR "/out-noplots", 3, none, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e != 0) fail_msg("--set snapshot_plots=[] sort_interval=1: expected success, got %d: %s", e, msg);
 }
 
 static void test_existing_output(void **state) {

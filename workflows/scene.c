@@ -1070,8 +1070,9 @@ static int read_hydrostatic(rd *r, const wf_node *v, const char *p, wf_scene *sc
 static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
   const wf_node *ls = map_get(root, "snapshot_plots");
   if (!ls) return 0;
-  if (ls->kind != WF_SEQ || ls->n == 0)
+  if (ls->kind != WF_SEQ)
     return fail_at(r, ls, "snapshot_plots", "expected a list, e.g. - {stage: runout, times: [1, 2], color: eps_p}");
+  if (ls->n == 0) return 0; /* [] : none (e.g. --set snapshot_plots=[] for a short run) */
   sc->snapplots = calloc((size_t)ls->n, sizeof *sc->snapplots);
   if (!sc->snapplots) return fail_at(r, ls, "snapshot_plots", "out of memory");
   sc->nsnapplot = ls->n;

@@ -85,11 +85,39 @@ int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, d
   return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
 }
 
+/* The plastic part of the tensor-form return (return_map.h): from the trial b, its
+ * deviatoric Hencky strain e (scaled in place to the returned one), tr eps, q_trial > k0. */
+int mpmc_j2_plastic(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, const double *b,
+                    double *e, double tr, double qtr, double k0, double *be, double *eps_p,
+                    double *tau, double *J_out, mpmc_j2_info *info) {
+  double dg, qn, en[6], bn[6];
+  info->plastic = 1;
+  MPMC_CALL(mpmc_rm_solve_k(ws, solver, m, qtr, *eps_p, k0, &dg, &qn, info));
+  const double f = qn / qtr; /* radial return: = 1 - 3G dgamma / q_trial */
+  /* b_e = exp(2 eps_new) = exp(2 eps_tr) exp(2 (f - 1) e) = b exp(2 (f - 1) e): b and the
+   * correction commute (both functions of e), and the correction's series is short for
+   * the small returns of most plastic steps (never longer than exp(2 e)'s) */
+  for (int k = 0; k < 6; ++k) en[k] = 2.0 * (f - 1.0) * e[k];
+  if (mpmc_sym3_exp_series(en, bn)) { /* not reached for |eps| < 0.18; stay safe */
+    *info = (mpmc_j2_info){0};
+    return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
+  }
+  mpmc_sym3_mul(b, bn, be);
+  for (int k = 0; k < 6; ++k) e[k] *= f;
+  *eps_p += dg;
+  const double G2 = 2.0 * m->G;
+  for (int k = 0; k < 6; ++k) tau[k] = G2 * e[k];
+  for (int k = 0; k < 3; ++k) tau[k] += m->K * tr;
+  if (J_out) *J_out = exp(tr);
+  return MPMC_SUCCESS;
+}
+
 /* The return in tensor form, without an eigen-decomposition, whenever the trial Hencky
  * strain eps = 1/2 ln b is small enough for the series of linalg.h (|eps| <~ 0.18):
  * tau = K tr(eps) I + 2G dev(eps) is coaxial with eps by construction, the radial return
  * scales dev(eps), and only a plastic point needs b_e = exp(2 tr/3) exp(2 dev eps_new).
- * Both paths agree to round-off (tests/t411).  Inlined into the point loop below. */
+ * Both paths agree to round-off (tests/t411).  The point-by-point reference of the blocks
+ * of stress_j2.c. */
 static inline int return_map_point(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m,
                                    double F[3][3], double *be, double *eps_p, double *tau,
                                    double *J_out, mpmc_j2_info *info) {
@@ -103,33 +131,13 @@ static inline int return_map_point(mpmc_rm_ws *ws, int solver, const mpmc_j2_par
   for (int k = 0; k < 6; ++k) e[k] = eps[k];
   for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
   const double qtr = sqrt(1.5 * mpmc_sym3_norm2(e)) * G2;
-  double J;
   const double k0 = mpmc_j2_kappa(m, *eps_p);
   MPMC_CALL(trial_info(info, qtr, k0));
-  if (qtr > k0) {
-    double dg, qn, en[6], bn[6];
-    info->plastic = 1;
-    MPMC_CALL(mpmc_rm_solve_k(ws, solver, m, qtr, *eps_p, k0, &dg, &qn, info));
-    const double f = qn / qtr; /* radial return: = 1 - 3G dgamma / q_trial */
-    /* b_e = exp(2 eps_new) = exp(2 eps_tr) exp(2 (f - 1) e) = b exp(2 (f - 1) e): b and the
-     * correction commute (both functions of e), and the correction's series is short for
-     * the small returns of most plastic steps (never longer than exp(2 e)'s) */
-    for (int k = 0; k < 6; ++k) en[k] = 2.0 * (f - 1.0) * e[k];
-    if (mpmc_sym3_exp_series(en, bn)) { /* not reached for |eps| < 0.18; stay safe */
-      *info = (mpmc_j2_info){0};
-      return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
-    }
-    mpmc_sym3_mul(b, bn, be);
-    for (int k = 0; k < 6; ++k) e[k] *= f;
-    *eps_p += dg;
-    J = exp(tr);
-  } else {
-    for (int k = 0; k < 6; ++k) be[k] = b[k]; /* elastic: keep b_e as pushed forward */
-    J = exp(tr);
-  }
+  if (qtr > k0) return mpmc_j2_plastic(ws, solver, m, b, e, tr, qtr, k0, be, eps_p, tau, J_out, info);
+  for (int k = 0; k < 6; ++k) be[k] = b[k]; /* elastic: keep b_e as pushed forward */
   for (int k = 0; k < 6; ++k) tau[k] = G2 * e[k];
   for (int k = 0; k < 3; ++k) tau[k] += m->K * tr;
-  if (J_out) *J_out = J;
+  if (J_out) *J_out = exp(tr);
   return MPMC_SUCCESS;
 }
 

@@ -71,6 +71,14 @@ int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, doubl
                        double *be, double *eps_p, double *tau, double *J_out,
                        mpmc_j2_info *info);
 
+/* The plastic part of mpmc_j2_return_map's series path, for callers that formed the trial
+ * state themselves (stress_j2.c): b the trial b_e, e its deviatoric Hencky strain (returned
+ * scaled to the new one), tr its trace, qtr > k0 = kappa(eps_p) the trial von Mises stress;
+ * writes be, eps_p, tau, J_out (may be NULL) and info->plastic, the solver's fields. */
+int mpmc_j2_plastic(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, const double *b,
+                    double *e, double tr, double qtr, double k0, double *be, double *eps_p,
+                    double *tau, double *J_out, mpmc_j2_info *info);
+
 /* The same by the eigen-decomposition of the trial b_e for every point (mpmc_j2_return_map
  * takes the eigen-free series of linalg.h when |ln b_e| <~ 0.36): the reference of tests/t411. */
 int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double F[3][3],

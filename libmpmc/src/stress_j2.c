@@ -8,9 +8,10 @@
  * every point, so four neighbouring points go through them at once in vectors of four
  * doubles (one AVX2 register, two SSE2 ones).  The series takes the degree the largest
  * strain of the four needs (the terms beyond a point's own degree are below its 2^-54
- * tolerance).  A point that turns out plastic, or whose strain is too large for the series,
- * is handed to the scalar return map (material_hencky_j2.c, mpmc_j2_return_map) from its
- * unchanged inputs; points of other materials in a block are masked out.  The blocks are
+ * tolerance).  A plastic point continues alone from its trial state (the scalar solve and
+ * b_e, mpmc_j2_plastic); one whose strain is too large for the series, or not finite, goes
+ * to the scalar return map (material_hencky_j2.c, mpmc_j2_return_map) from its unchanged
+ * inputs; points of other materials in a block are masked out.  The blocks are
  * fixed by the point index (points 4k .. 4k+3), so the results do not depend on the thread
  * count, and the two instruction sets give the same bits (ISO C: no contraction). */
 #include <limits.h>
@@ -112,7 +113,9 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
     tid = omp_get_thread_num();
 #endif
     mpmc_rm_ws *w = ws[tid];
-#pragma omp for schedule(static)
+    /* dynamic: plastic points cost several elastic ones and gather where the soil fails,
+     * which after a sort by cell is one stretch of the index range */
+#pragma omp for schedule(dynamic, 64)
     for (int blk = 0; blk < nblk; ++blk) {
       const int q0 = 4 * blk;
       int act[4], nact = 0;
@@ -164,19 +167,28 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         const double k0 = par.kappa_r + (par.kappa_p - par.kappa_r) * (x == 0.0 ? 1.0 : exp(-x));
         const double qtr = sqrt(q2[l]) * G2;
         double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
-        if (!fail[l] && qtr <= k0 && detb[l] > 0.0) { /* elastic: b_e = trial b */
-          const double inv_J = 1.0 / sqrt(detb[l]);
-          for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
-          for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
-          continue;
-        }
-        /* plastic, outside the series, or not finite: the scalar return map from the
-         * unchanged b_e^n and dF */
-        double Fl[3][3], tau[6], J;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) Fl[i][j] = F[3 * i + j][l];
+        double tau[6], J;
         mpmc_j2_info info = {0};
-        const int err = mpmc_j2_return_map(w, solver, &par, Fl, be, ep, tau, &J, &info);
+        int err;
+        if (!fail[l] && isfinite(qtr) && detb[l] > 0.0) {
+          if (qtr <= k0) { /* elastic: b_e = trial b */
+            const double inv_J = 1.0 / sqrt(detb[l]);
+            for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
+            for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
+            continue;
+          }
+          /* plastic: the scalar solve and b_e from this trial state */
+          double bl[6], el[6];
+          for (int k = 0; k < 6; ++k) bl[k] = bt[k][l], el[k] = e[k][l];
+          info.q_trial = qtr;
+          info.kappa = k0;
+          err = mpmc_j2_plastic(w, solver, &par, bl, el, tr[l], qtr, k0, be, ep, tau, &J, &info);
+        } else { /* outside the series or not finite: the scalar map from b_e^n and dF */
+          double Fl[3][3];
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) Fl[i][j] = F[3 * i + j][l];
+          err = mpmc_j2_return_map(w, solver, &par, Fl, be, ep, tau, &J, &info);
+        }
         if (err) {
           if (q < first_bad) first_bad = q;
           continue;
