@@ -33,7 +33,7 @@ static double bytes_per_point(const mpmc_sim sim) {
            {p->be, 6},         {p->eps_p, 1},   {p->lp, 1},      {p->force, d},
            {p->cforce, d},     {p->ustate, p->nustate},          {p->dF, d * d},
            {p->xn, d}};
-  double b = sizeof(int) * 2.0; /* material id, slab order */
+  double b = sizeof(int) * (p->id ? 3.0 : 2.0); /* material id, slab order, point id (sort) */
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
     if (f[i].a) b += sizeof(double) * (double)f[i].n;
   return b;
