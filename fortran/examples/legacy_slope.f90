@@ -8,7 +8,7 @@
 !   legacy_slope [key=value ...]
 !
 ! The keys are those of `mpmc run --set` that a smaller or faster run needs:
-!   threads, grid.cell_size, fbar, stages.gravity.end.kinetic_energy_ratio,
+!   threads, sort_interval, grid.cell_size, fbar, stages.gravity.end.kinetic_energy_ratio,
 !   stages.gravity.end.max_time, stages.gravity.end.min_time,
 !   stages.strength_reduction.end.time, stages.runout.end.time, metrics.runout_distance.toe
 ! Run-out distance (docs/workflows.md): max(0, max_p x_p - x_toe) with x_toe = 14.95 m.
@@ -47,6 +47,7 @@ program legacy_slope
   real(c_double) :: runout_time = 5.0_c_double
   real(c_double) :: toe = 14.95_c_double
   integer(c_int) :: threads = 0 ! OpenMP's default, as the scene
+  integer(c_int) :: sort_every = 100 ! steps between sorts of the points by cell, as `mpmc`
 
   type(mpmc_context) :: ctx
   type(mpmc_sim) :: sim
@@ -70,6 +71,7 @@ program legacy_slope
   call check(mpmc_sim_set_flip_blend(sim, flip), 'flip')
   call check(mpmc_sim_set_solver(sim, MPMC_SOLVER_AUTO), 'solver')
   call check(mpmc_sim_set_threads(sim, threads), 'threads')
+  call check(mpmc_sim_set_sort_interval(sim, sort_every), 'sort_interval')
   call check(mpmc_sim_add_material_hencky_j2(sim, E, nu, rho, kappa_p, kappa_r, eta, mat), &
     'materials.clay')
   call check(mpmc_sim_seed_polygon(sim, 4_c_int, slope, ppc, mat, first, count), 'geometry')
@@ -134,6 +136,8 @@ contains
     select case (key)
     case ('threads')
       read (val, *, iostat=ios) threads
+    case ('sort_interval')
+      read (val, *, iostat=ios) sort_every
     case ('grid.cell_size')
       read (val, *, iostat=ios) cell
     case ('fbar')
@@ -164,7 +168,7 @@ contains
   subroutine usage(msg)
     character(*), intent(in) :: msg
     write (*, '(a,a)') 'legacy_slope: ', msg
-    write (*, '(a)') 'usage: legacy_slope [key=value ...] with keys threads, grid.cell_size, fbar,', &
+    write (*, '(a)') 'usage: legacy_slope [key=value ...] with keys threads, sort_interval, grid.cell_size, fbar,', &
       '  stages.gravity.end.kinetic_energy_ratio, stages.gravity.end.max_time,', &
       '  stages.gravity.end.min_time,', &
       '  stages.strength_reduction.end.time, stages.runout.end.time, metrics.runout_distance.toe'
