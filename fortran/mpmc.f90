@@ -928,14 +928,11 @@ contains
   function mpmc_sim_get_material_ids(sim, ids) result(ierr)
     type(mpmc_sim), intent(in) :: sim
     integer(c_int), pointer, intent(out) :: ids(:)
-    integer(c_int) :: ierr, np
+    integer(c_int) :: ierr
     type(c_ptr) :: p
     nullify (ids)
     ierr = mpmc_sim_get_material_ids_c(sim, p)
-    if (ierr /= MPMC_SUCCESS) return
-    ierr = mpmc_sim_get_num_particles(sim, np)
-    if (ierr /= MPMC_SUCCESS) return
-    if (c_associated(p)) call c_f_pointer(p, ids, [np])
+    if (ierr == MPMC_SUCCESS) ierr = point_ints(sim, p, ids)
   end function mpmc_sim_get_material_ids
 
   !> Borrow the id of each point, ids(np): the 0-based index the point was added with (equal
@@ -943,15 +940,24 @@ contains
   function mpmc_sim_get_particle_ids(sim, ids) result(ierr)
     type(mpmc_sim), intent(in) :: sim
     integer(c_int), pointer, intent(out) :: ids(:)
-    integer(c_int) :: ierr, np
+    integer(c_int) :: ierr
     type(c_ptr) :: p
     nullify (ids)
     ierr = mpmc_sim_get_particle_ids_c(sim, p)
-    if (ierr /= MPMC_SUCCESS) return
+    if (ierr == MPMC_SUCCESS) ierr = point_ints(sim, p, ids)
+  end function mpmc_sim_get_particle_ids
+
+  ! a C array of one int per point as ids(np)
+  function point_ints(sim, p, ids) result(ierr)
+    type(mpmc_sim), intent(in) :: sim
+    type(c_ptr), intent(in) :: p
+    integer(c_int), pointer, intent(out) :: ids(:)
+    integer(c_int) :: ierr, np
+    nullify (ids)
     ierr = mpmc_sim_get_num_particles(sim, np)
     if (ierr /= MPMC_SUCCESS) return
     if (c_associated(p)) call c_f_pointer(p, ids, [np])
-  end function mpmc_sim_get_particle_ids
+  end function point_ints
 
   !> Borrow the user-material state without a copy: state(nstate, np), nstate the row
   !> length (the widest user material's); unassociated when no user material has state.

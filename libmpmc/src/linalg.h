@@ -138,12 +138,15 @@ static inline double mpmc_sym3_norm2(const double *s) {
  * 1/2 ln(lambda) carries an absolute error of ~1e-16 (round-off of lambda ~ 1).
  * Returns 0, or 1 when |Z|_F > 0.179 (|eps| >~ 0.18: use the eigen path) or b is not
  * finite; a b with eigenvalues <= 0 gives |z| >= 1 or a singular b + I, so also 1. */
+/* the series' tables: the largest |Z|^2 for n terms, and the coefficients 1/(2k+1) (also
+ * stress_j2.c's, which sums the same series four points at a time) */
+static const double mpmc_atanh_rho2_max[11] = {0.0,        1.665e-16,  1.666e-08, 7.297e-06,
+                                               1.4949e-04, 9.0589e-04, 2.9934e-03, 7.0039e-03,
+                                               1.3216e-02, 2.1619e-02, 3.2007e-02};
+static const double mpmc_atanh_c[10] = {1.0,        1.0 / 3.0,  1.0 / 5.0,  1.0 / 7.0,  1.0 / 9.0,
+                                        1.0 / 11.0, 1.0 / 13.0, 1.0 / 15.0, 1.0 / 17.0, 1.0 / 19.0};
 static inline int mpmc_sym3_log_series(const double *b, double *eps) {
-  static const double rho2_max[11] = {0.0,       1.665e-16, 1.666e-08, 7.297e-06,
-                                      1.4949e-04, 9.0589e-04, 2.9934e-03, 7.0039e-03,
-                                      1.3216e-02, 2.1619e-02, 3.2007e-02};
-  static const double c[10] = {1.0,       1.0 / 3.0,  1.0 / 5.0,  1.0 / 7.0,  1.0 / 9.0,
-                               1.0 / 11.0, 1.0 / 13.0, 1.0 / 15.0, 1.0 / 17.0, 1.0 / 19.0};
+  const double *rho2_max = mpmc_atanh_rho2_max, *c = mpmc_atanh_c;
   const double a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
   const double m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
   const double adj[6] = {m[1] * m[2] - m[3] * m[3], m[0] * m[2] - m[4] * m[4],

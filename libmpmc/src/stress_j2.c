@@ -47,11 +47,7 @@ static inline void norm2_4(const v4 *s, v4 *r) {
  * Horner scheme), at the degree the largest active lane needs.  fail[l] = 1 for a lane
  * whose strain the series cannot take (|Z|^2 above the table, or not finite). */
 static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) {
-  static const double rho2_max[11] = {0.0,       1.665e-16, 1.666e-08, 7.297e-06,
-                                      1.4949e-04, 9.0589e-04, 2.9934e-03, 7.0039e-03,
-                                      1.3216e-02, 2.1619e-02, 3.2007e-02};
-  static const double c[10] = {1.0,       1.0 / 3.0,  1.0 / 5.0,  1.0 / 7.0,  1.0 / 9.0,
-                               1.0 / 11.0, 1.0 / 13.0, 1.0 / 15.0, 1.0 / 17.0, 1.0 / 19.0};
+  const double *rho2_max = mpmc_atanh_rho2_max, *c = mpmc_atanh_c;
   const v4 a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
   const v4 m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
   const v4 adj[6] = {m[1] * m[2] - m[3] * m[3], m[0] * m[2] - m[4] * m[4],
