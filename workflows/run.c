@@ -232,6 +232,7 @@ static void log_plan(const wf_run *w) {
   FEATURE(tractions, "tractions");
   FEATURE(srf, "strength reduction");
   FEATURE(sc->nrigid > 0, "rigid-body contact");
+  FEATURE(sc->sort_interval > 0, "sorting by cell (sort_interval)");
 #ifdef MPMC_WF_HAVE_CHECKPOINT
   FEATURE(1, "checkpoints");
 #else
