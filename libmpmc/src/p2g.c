@@ -10,8 +10,8 @@
 #include "transfer.h"
 
 /* Bucket the points into slabs of whole cell planes along one axis (a stable counting sort
- * of indices; the particle arrays themselves are not moved, so indices held by callers,
- * particle sets and rigid-body anchors stay valid), and set the grid's active box to the
+ * of indices; the particle arrays themselves are not moved here: sort.c does that, every
+ * sort_interval steps when the caller asks for it), and set the grid's active box to the
  * nodes the points' stencils reach.  Within a slab the points keep their index order: with
  * the points shuffled, visiting them by cell instead (grid in order, particle arrays at
  * random) was slower than this (particle arrays in order, grid at random) on the 3D column.

@@ -7,7 +7,8 @@
  * were seeded and the store loses that order; mpmc_sim_sort_particles restores it by a
  * stable counting sort on the cell, with the slab axis (the longest extent of the points,
  * as p2g.c picks it) outermost and the others in the grid's memory order, so that a slab is
- * one contiguous run of points.
+ * one contiguous run of points; within a cell the points go by the half of the cell they lie
+ * in along each axis, the same order in every cell (the kernels' branches then repeat).
  *
  * Every per-point array moves with the points: the fields, the material ids, the friction
  * anchors of the rigid bodies, the user materials' state, and the particle sets' indices are
@@ -114,7 +115,10 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
   const int n = p->n, d = sim->dim;
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "sort: set the grid first");
   MPMC_CALL(ensure_ids(sim));
-  if (n < 2) return MPMC_SUCCESS;
+  if (n < 2) {
+    sim->sort_last = sim->stats.steps;
+    return MPMC_SUCCESS;
+  }
   /* scratch: the step's dF array (free between steps) when it is there, else a buffer */
   double *tmp = p->dF;
   int w = d * d;
