@@ -6,7 +6,8 @@
  * and a user material whose state is each point's own history.  Also: the sort really puts
  * the points in cell order, field pointers stay valid, the ids are the indices points were
  * added with (new points too), a checkpoint carries ids and the sort schedule (the restarted
- * run is the same bits as the straight one), and bad input is refused. */
+ * run is the same bits as the straight one), an error names a moved point by index and id,
+ * and bad input is refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -295,6 +296,21 @@ static void test_ids(void **state) {
   TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, &nc));
   for (int q = 0; q < n + 2; ++q)
     if (ids[q] >= n && x0[2 * q] != xn[2 * (ids[q] - n)]) fail_msg("new point id %d lost its position", ids[q]);
+  /* an error names a moved point by index and id: throw the points out of the grid */
+  {
+    double *v;
+    TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+    for (int q = 0; q < n + 2; ++q) v[2 * q] = 1e4;
+    TCALL(mpmc_sim_set_force_dt(sim, 1));
+    const int e = mpmc_sim_step(sim, 1e-3);
+    const char *msg = mpmc_context_last_error(ctx), *at = strstr(msg, ": point ");
+    int qi = -1, qid = -1;
+    if (e == MPMC_SUCCESS || !at || sscanf(at, ": point %d (id %d)", &qi, &qid) != 2)
+      fail_msg("a point thrown out: code %d, '%s' (expected 'point N (id M)')", e, msg);
+    TCALL(mpmc_sim_get_particle_ids(sim, &ids));
+    if (qi < 0 || qi >= n + 2 || ids[qi] != qid) fail_msg("message names point %d as id %d, its id is %d", qi, qid, qi >= 0 && qi < n + 2 ? ids[qi] : -1);
+    mpmc_context_clear_error(ctx);
+  }
   /* bad input */
   if (mpmc_sim_set_sort_interval(sim, -1) != MPMC_ERR_ARG ||
       !strstr(mpmc_context_last_error(ctx), "sort interval"))

@@ -240,10 +240,11 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
     if (bad != INT_MAX) {
       double n[3];
       const double *x = p->x + (size_t)bad * d;
+      char nb[MPMC_POINT_NAME_LEN];
       return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
-                        "step %lld, t = %g: point %d at (%g, %g, %g) is inside rigid body %d "
+                        "step %lld, t = %g: point %s at (%g, %g, %g) is inside rigid body %d "
                         "(gap %g <= 0)",
-                        (long long)sim->stats.steps, sim->time, bad, x[0], x[1],
+                        (long long)sim->stats.steps, sim->time, mpmc_point_name(p, bad, nb), x[0], x[1],
                         d == 3 ? x[2] : 0.0, bi, body_gap(b, d, x, n));
     }
     b->reaction[0] = r0;
@@ -294,11 +295,12 @@ int mpmc_contact_check(struct mpmc_sim_s *sim) {
     if (bad != INT_MAX) {
       double n[3];
       const double *x = sim->p.x + (size_t)bad * d;
+      char nb[MPMC_POINT_NAME_LEN];
       return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
-                        "step %lld, t = %g: point %d crossed into rigid body %d, now at (%g, %g, "
+                        "step %lld, t = %g: point %s crossed into rigid body %d, now at (%g, %g, "
                         "%g) with gap %g <= 0 (barrier dhat = %g, kappa = %g): reduce the time "
                         "step (mpmc_sim_stable_dt) or the body's velocity",
-                        (long long)sim->stats.steps, sim->time, bad, bi, x[0], x[1],
+                        (long long)sim->stats.steps, sim->time, mpmc_point_name(&sim->p, bad, nb), bi, x[0], x[1],
                         d == 3 ? x[2] : 0.0, body_gap(b, d, x, n), dhat, kappa);
     }
   }

@@ -153,15 +153,17 @@ static int report(mpmc_sim sim, int q) {
   const double *x = (sim->fbar ? p->xn : p->x) + (size_t)q * d;
   const double *dF = p->dF + (size_t)q * d * d;
   const double dJ = d == 2 ? mpmc_det_dim(2, dF) : mpmc_det_dim(3, dF);
+  char nb[MPMC_POINT_NAME_LEN];
+  mpmc_point_name(p, q, nb);
   if (!(p->J[q] > 0.0) || !isfinite(p->J[q]))
     return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
-                      "step %lld, t = %g: point %d at (%g, %g, %g) inverted or lost its volume "
+                      "step %lld, t = %g: point %s at (%g, %g, %g) inverted or lost its volume "
                       "(J = %g%s): reduce the time step",
-                      (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0,
+                      (long long)sim->stats.steps, sim->time, nb, x[0], x[1], d == 3 ? x[2] : 0.0,
                       p->J[q], dJ <= 0 ? ", dJ <= 0" : "");
   return MPMC_ERROR(sim->ctx, MPMC_ERR_OUTSIDE,
-                    "step %lld, t = %g: point %d left the grid box at (%g, %g, %g)",
-                    (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0);
+                    "step %lld, t = %g: point %s left the grid box at (%g, %g, %g)",
+                    (long long)sim->stats.steps, sim->time, nb, x[0], x[1], d == 3 ? x[2] : 0.0);
 }
 
 /** Phase 3 of the step. */

@@ -186,12 +186,13 @@ static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) 
   mpmc_embed(d, p->dF + (size_t)q * d * d, F);
   const int err = mpmc_j2_return_map(ws[0], solver, &par, F, be, &ep, tau, &J, &info);
   const double *x = p->x + (size_t)q * d;
+  char nb[MPMC_POINT_NAME_LEN];
   return MPMC_ERROR(sim->ctx, err ? err : MPMC_ERR_SOLVER,
-                    "step %lld, t = %g: return map of point %d at (%g, %g, %g) (material %d, "
+                    "step %lld, t = %g: return map of point %s at (%g, %g, %g) (material %d, "
                     "solver %s) failed: trial q = %g, kappa = %g, eps_p = %g, dgamma = %g, "
                     "|g| = %g, KINSOL flag %d",
-                    (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0, id,
-                    solver_name(solver), info.q_trial, info.kappa, p->eps_p[q], info.dgamma,
+                    (long long)sim->stats.steps, sim->time, mpmc_point_name(p, q, nb), x[0], x[1],
+                    d == 3 ? x[2] : 0.0, id, solver_name(solver), info.q_trial, info.kappa, p->eps_p[q], info.dgamma,
                     info.residual, info.kinsol_flag);
 }
 

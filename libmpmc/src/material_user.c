@@ -131,10 +131,11 @@ static int user_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt
   /* Several points may fail in one step: name the lowest index and one of the codes. */
   const int q = first_bad;
   const double *x = p->x + (size_t)q * d;
+  char nb[MPMC_POINT_NAME_LEN];
   return MPMC_ERROR(sim->ctx, MPMC_ERR_SOLVER,
-                    "step %lld, t = %g: user material %d stress function failed at point %d "
+                    "step %lld, t = %g: user material %d stress function failed at point %s "
                     "(%g, %g, %g) (returned %d)",
-                    (long long)sim->stats.steps, sim->time, id, q, x[0], x[1],
+                    (long long)sim->stats.steps, sim->time, id, mpmc_point_name(p, q, nb), x[0], x[1],
                     d == 3 ? x[2] : 0.0, code);
 }
 

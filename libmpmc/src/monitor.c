@@ -126,10 +126,11 @@ int mpmc_monitor_step(mpmc_sim sim) {
   const sums s = pass(sim, changed && energy);
   if (s.bad != INT_MAX) {
     const double *x = p->x + (size_t)s.bad * d, *v = p->v + (size_t)s.bad * d;
+    char nb[MPMC_POINT_NAME_LEN];
     return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
-                      "step %lld, t = %g: point %d at (%g, %g, %g) has a non-finite velocity "
+                      "step %lld, t = %g: point %s at (%g, %g, %g) has a non-finite velocity "
                       "(%g, %g, %g): reduce the time step",
-                      (long long)sim->stats.steps, sim->time, s.bad, x[0], x[1],
+                      (long long)sim->stats.steps, sim->time, mpmc_point_name(p, s.bad, nb), x[0], x[1],
                       d == 3 ? x[2] : 0.0, v[0], v[1], d == 3 ? v[2] : 0.0);
   }
   /* a new baseline when the inputs changed, or sum |f| without a new force array */
@@ -162,6 +163,7 @@ int mpmc_monitor_step(mpmc_sim sim) {
     }
   }
   const double *x = p->x + (size_t)q * d;
+  char nb[MPMC_POINT_NAME_LEN];
   /* The forms that project det F itself follow the points' own J, which drifts in a large
    * flow (splashing, run-up; docs/theory.md): say so, with the range of J. */
   char hint[256] = "";
@@ -177,10 +179,10 @@ int mpmc_monitor_step(mpmc_sim sim) {
   return MPMC_ERROR(sim->ctx, MPMC_ERR_UNSTABLE,
                     "step %lld, t = %g: kinetic energy grows without input: E_k = %.4g J exceeds "
                     "%g x the %.4g J available since step %lld (kinetic %.3g + elastic %.3g + "
-                    "work of gravity %.3g + of loads %.3g); fastest point %d at (%g, %g, %g), "
+                    "work of gravity %.3g + of loads %.3g); fastest point %s at (%g, %g, %g), "
                     "|v| = %.4g m/s: the run is unstable, reduce the time step%s",
                     (long long)sim->stats.steps, sim->time, s.ke, factor, avail,
-                    (long long)mo->base_step, mo->e0[0], mo->e0[1], wg, wf, q, x[0], x[1],
+                    (long long)mo->base_step, mo->e0[0], mo->e0[1], wg, wf, mpmc_point_name(p, q, nb), x[0], x[1],
                     d == 3 ? x[2] : 0.0, sqrt(s.v2max), hint);
 }
 

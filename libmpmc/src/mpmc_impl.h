@@ -4,6 +4,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "mpmc.h"
 
@@ -64,6 +65,17 @@ typedef struct {
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
   double *xn;    /* [n][dim] new positions while F-bar still needs the old ones    */
 } mpmc_particles;
+
+/* A point's name in error messages: its index, and its id (the index it was added with)
+ * when a sort by cell has moved it, e.g. "57 (id 1203)". */
+#define MPMC_POINT_NAME_LEN 40
+static inline const char *mpmc_point_name(const mpmc_particles *p, int q, char *buf) {
+  if (p->id && p->id[q] != q)
+    snprintf(buf, MPMC_POINT_NAME_LEN, "%d (id %d)", q, p->id[q]);
+  else
+    snprintf(buf, MPMC_POINT_NAME_LEN, "%d", q);
+  return buf;
+}
 
 int mpmc_particles_reserve(mpmc_context ctx, mpmc_particles *p, int cap);
 int mpmc_particles_ensure(mpmc_context ctx, mpmc_particles *p, double **field, int ncomp,

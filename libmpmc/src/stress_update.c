@@ -20,10 +20,12 @@ int mpmc_stress_update(mpmc_sim sim, double dt) {
   if (first_bad != INT_MAX) {
     const int q = first_bad, d = sim->dim;
     const double *x = p->x + (size_t)q * d;
+    char nb[MPMC_POINT_NAME_LEN];
     return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
-                      "step %lld, t = %g: point %d at (%g, %g, %g) (material %d) has a non-finite "
+                      "step %lld, t = %g: point %s at (%g, %g, %g) (material %d) has a non-finite "
                       "stress after the stress update",
-                      (long long)sim->stats.steps, sim->time, q, x[0], x[1], d == 3 ? x[2] : 0.0,
+                      (long long)sim->stats.steps, sim->time, mpmc_point_name(p, q, nb), x[0], x[1],
+                      d == 3 ? x[2] : 0.0,
                       p->mat[q]);
   }
   return MPMC_SUCCESS;
