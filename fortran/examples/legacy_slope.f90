@@ -46,7 +46,7 @@ program legacy_slope
   ! stage 3, runout
   real(c_double) :: runout_time = 5.0_c_double
   real(c_double) :: toe = 14.95_c_double
-  integer(c_int) :: threads = 0 ! OpenMP's default, as the scene
+  integer(c_int) :: threads = 1 ! as the scene (threads: 1)
   integer(c_int) :: sort_every = 100 ! steps between sorts of the points by cell, as `mpmc`
 
   type(mpmc_context) :: ctx
