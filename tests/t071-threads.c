@@ -9,6 +9,9 @@
 #include <string.h>
 
 #include <cmocka.h>
+#include <limits.h>
+
+#include "mpmc_impl.h"
 
 #include "test_util.h"
 
@@ -94,8 +97,63 @@ static void test_3d_ugimp_stable(void **state) {
   check(3, MPMC_FBAR_STABLE, MPMC_BASIS_UGIMP);
 }
 
+/* The slab order of P2G (p2g.c, built for two threads' worth of slabs) is a stable counting
+ * sort: a permutation, slabs in plane order, every point in its own slab's planes, and within
+ * a slab the points in index order (points stored at random). */
+static void test_slab_order(void **state) {
+  (void)state;
+  mpmc_context ctx;
+  mpmc_sim sim;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  TCALL(mpmc_sim_create(ctx, 3, &sim));
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1}, bhi[3] = {1.6, 0.7, 0.8};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
+  int mat, n;
+  TCALL(mpmc_sim_add_material_hencky(sim, 1e6, 0.3, 1000, &mat));
+  TCALL(mpmc_sim_seed_box(sim, lo, bhi, 2, mat, NULL, &n));
+  if (n <= 4096) fail_msg("expected more than MPMC_OMP_MIN points, got %d", n);
+  double *x;
+  TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL));
+  srand(3);
+  for (int q = n - 1; q > 0; --q) {
+    const int r = rand() % (q + 1);
+    for (int a = 0; a < 3; ++a) {
+      const double t = x[3 * q + a];
+      x[3 * q + a] = x[3 * r + a], x[3 * r + a] = t;
+    }
+  }
+  TCALL(mpmc_sim_prepare(sim));
+  TCALL(mpmc_slabs_build(sim)); /* slabs for OMP_NUM_THREADS = 2 (CTest's environment) */
+  const int ax = sim->slab_axis, ns = sim->nslab;
+  if (ns < 4) fail_msg("%d slabs: expected at least 4 for two threads (OMP_NUM_THREADS=2)", ns);
+  const mpmc_grid *g = &sim->grid;
+  unsigned char *seen = calloc((size_t)n, 1);
+  int last_plane = -1;
+  for (int sl = 0; sl < ns; ++sl) {
+    int pmin = INT_MAX, pmax = -1;
+    for (int k = sim->slab_start[sl]; k < sim->slab_start[sl + 1]; ++k) {
+      const int q = sim->order[k];
+      if (q < 0 || q >= n || seen[q]) fail_msg("order[%d] = %d: not a permutation", k, q);
+      seen[q] = 1;
+      if (k > sim->slab_start[sl] && q < sim->order[k - 1])
+        fail_msg("slab %d: point %d after point %d (not in index order)", sl, q, sim->order[k - 1]);
+      const int pl = (int)((x[3 * q + ax] - g->origin[ax]) * g->inv_h);
+      pmin = pl < pmin ? pl : pmin;
+      pmax = pl > pmax ? pl : pmax;
+    }
+    if (pmin <= last_plane) fail_msg("slab %d starts at plane %d, the slab before ends at %d", sl, pmin, last_plane);
+    last_plane = pmax;
+  }
+  if (sim->slab_start[ns] != n) fail_msg("slabs hold %d of %d points", sim->slab_start[ns], n);
+  free(seen);
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_2d_fbar), cmocka_unit_test(test_2d_ugimp_total),
-                                     cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable)};
+                                     cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable),
+                                     cmocka_unit_test(test_slab_order)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
