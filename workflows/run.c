@@ -598,6 +598,8 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
   fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
   fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
           st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);
+  fprintf(f, "  \"return_maps\": %lld,\n  \"kinsol_fallbacks\": %lld,\n", (long long)st.return_maps,
+          (long long)st.kinsol_fallbacks);
   fputs("  \"stages\": [", f);
   for (int i = 0; i < nstages_done; ++i) {
     const stage_record *r = &w->rec[i];
