@@ -194,13 +194,34 @@ static int solve_kinsol(mpmc_rm_ws *ws, const mpmc_j2_param *m, double qtr, doub
 /* Newton on the bracket [lo, hi] of y, from hi (the perfect-plasticity predictor
  * y = kappa(eps_p)).  strict = 1 (auto): return 1 ("stiff") instead of safeguarding;
  * strict = 0 (newton): bisect whenever the Newton step leaves the bracket. */
+/* exp(-x) for the small x of Newton's iterates (x = eta dgamma: a step's plastic increment
+ * times the softening rate, mostly < 1e-2): Horner to x^6 / 6!, the tail below 2e-18 of the
+ * value; libm's exp beyond. */
+static inline double exp_neg_small(double x) {
+  if (!(fabs(x) <= 1e-2)) return exp(-x);
+  return 1.0 - x * (1.0 - x * (1.0 / 2.0) * (1.0 - x * (1.0 / 3.0) * (1.0 - x * (1.0 / 4.0) *
+                                                   (1.0 - x * (1.0 / 5.0) * (1.0 - x * (1.0 / 6.0))))));
+}
+
+/* rm_r with kappa(eps_p) - kappa_r = a = (kappa_p - kappa_r) exp(-eta eps_p) known (the
+ * caller's kappa0 - kappa_r) and c = eta / 3G: kappa(eps_p + dgamma) - kappa_r =
+ * a exp(-eta dgamma), so an iterate costs a short polynomial instead of an exp. */
+static inline double rm_r_k(const mpmc_j2_param *m, double a, double c, double qtr, double y,
+                            double *dr) {
+  const double e = a * exp_neg_small(c * (qtr - y));
+  *dr = 1.0 - c * e;
+  return y - (m->kappa_r + e);
+}
+
 static int solve_newton(const mpmc_j2_param *m, double qtr, double ep0, double tol, int strict,
                         double *lo, double *hi, double *y, double *res, mpmc_j2_info *info) {
   double yi = *hi, rprev = INFINITY;
+  const double a = *hi - m->kappa_r, c = m->eta / (3.0 * m->G); /* *hi = kappa(eps_p) here */
+  (void)ep0;
   *res = NAN; /* |r(y)| when the returned y is an evaluated iterate, else NaN */
   for (int it = 0; it < RM_MAX_ITERS; ++it) {
     double dr;
-    const double r = rm_r(m, qtr, ep0, yi, &dr);
+    const double r = rm_r_k(m, a, c, qtr, yi, &dr);
     if (fabs(r) <= tol) {
       *y = yi;
       *res = fabs(r);
