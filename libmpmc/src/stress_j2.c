@@ -178,7 +178,8 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           for (int k = 0; k < 6; ++k) bl[k] = bt[k][l], el[k] = e[k][l];
           info.q_trial = qtr;
           info.kappa = k0;
-          err = mpmc_j2_plastic(w, solver, &par, bl, el, tr[l], qtr, k0, be, ep, tau, &J, &info);
+          err = mpmc_j2_plastic(w, solver, &par, bl, el, tr[l], qtr, k0, be, ep, tau, NULL, &info);
+          J = sqrt(detb[l]); /* = exp(tr eps): the flow is isochoric */
         } else { /* outside the series or not finite: the scalar map from b_e^n and dF */
           double Fl[3][3];
           for (int i = 0; i < 3; ++i)
