@@ -24,4 +24,9 @@ struct mpmc_bodies_s {
   double dhat, kappa; /* the caller's values; 0 = derive (docs/contact.md)          */
 };
 
+/* Friction anchors for every point (points added since the last contact pass start at
+ * rest: NaN, out of contact); contact_barrier.c and sort.c. */
+struct mpmc_sim_s;
+int mpmc_contact_grow_anchors(struct mpmc_sim_s *sim, mpmc_body *b);
+
 #endif

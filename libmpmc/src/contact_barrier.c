@@ -147,6 +147,18 @@ static inline double point_area(int dim, double vol0) {
 }
 
 /* ---- internal entry points (mpmc_impl.h) ---------------------------------------------- */
+
+int mpmc_contact_grow_anchors(struct mpmc_sim_s *sim, mpmc_body *b) {
+  const int n = sim->p.n;
+  if (b->nanchor >= n) return MPMC_SUCCESS;
+  double *a = realloc(b->anchor, sizeof *a * 3 * (size_t)n);
+  MPMC_CHECK(a, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate friction anchors of %d points", n);
+  for (size_t i = 3 * (size_t)b->nanchor; i < 3 * (size_t)n; ++i) a[i] = NAN;
+  b->anchor = a;
+  b->nanchor = n;
+  return MPMC_SUCCESS;
+}
+
 /* Barrier and friction forces of every active body on the points (p->cforce), the bodies'
  * reactions; then the bodies move by v dt. */
 int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
@@ -164,13 +176,7 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
     mpmc_body *b = &B->b[bi];
     if (!b->active) continue;
     const double mu = b->mu;
-    if (mu > 0.0 && b->nanchor < p->n) { /* anchors of new points start at rest */
-      double *a = realloc(b->anchor, sizeof *a * 3 * (size_t)p->n);
-      MPMC_CHECK(a, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate friction anchors of %d points", p->n);
-      for (size_t i = 3 * (size_t)b->nanchor; i < 3 * (size_t)p->n; ++i) a[i] = NAN;
-      b->anchor = a;
-      b->nanchor = p->n;
-    }
+    if (mu > 0.0) MPMC_CALL(mpmc_contact_grow_anchors(sim, b));
     double *restrict anc = mu > 0.0 ? b->anchor : NULL;
     const double vb[3] = {b->v[0], b->v[1], b->v[2]};
     double r0 = 0.0, r1 = 0.0, r2 = 0.0;

@@ -85,6 +85,14 @@ int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, d
   return return_map_eig(ws, solver, m, b, be, eps_p, tau, J_out, info);
 }
 
+/* tau = K tr(eps) I + 2G e and J = exp(tr eps) of the series path (e: dev eps) */
+static inline void series_tau(const mpmc_j2_param *m, const double *e, double tr, double *tau,
+                              double *J_out) {
+  for (int k = 0; k < 6; ++k) tau[k] = 2.0 * m->G * e[k];
+  for (int k = 0; k < 3; ++k) tau[k] += m->K * tr;
+  if (J_out) *J_out = exp(tr);
+}
+
 /* The plastic part of the tensor-form return (return_map.h): from the trial b, its
  * deviatoric Hencky strain e (scaled in place to the returned one), tr eps, q_trial > k0. */
 int mpmc_j2_plastic(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, const double *b,
@@ -105,10 +113,7 @@ int mpmc_j2_plastic(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, const do
   mpmc_sym3_mul(b, bn, be);
   for (int k = 0; k < 6; ++k) e[k] *= f;
   *eps_p += dg;
-  const double G2 = 2.0 * m->G;
-  for (int k = 0; k < 6; ++k) tau[k] = G2 * e[k];
-  for (int k = 0; k < 3; ++k) tau[k] += m->K * tr;
-  if (J_out) *J_out = exp(tr);
+  series_tau(m, e, tr, tau, J_out);
   return MPMC_SUCCESS;
 }
 
@@ -135,9 +140,7 @@ static inline int return_map_point(mpmc_rm_ws *ws, int solver, const mpmc_j2_par
   MPMC_CALL(trial_info(info, qtr, k0));
   if (qtr > k0) return mpmc_j2_plastic(ws, solver, m, b, e, tr, qtr, k0, be, eps_p, tau, J_out, info);
   for (int k = 0; k < 6; ++k) be[k] = b[k]; /* elastic: keep b_e as pushed forward */
-  for (int k = 0; k < 6; ++k) tau[k] = G2 * e[k];
-  for (int k = 0; k < 3; ++k) tau[k] += m->K * tr;
-  if (J_out) *J_out = exp(tr);
+  series_tau(m, e, tr, tau, J_out);
   return MPMC_SUCCESS;
 }
 

@@ -258,6 +258,15 @@ struct mpmc_sim_s {
  * so two slabs of the same parity, one slab apart, share no node when the slab between them
  * is wider than 2 cells (slabs are widened beyond this to balance the points per thread). */
 #define MPMC_SLAB_W 3
+/* The slab axis for points whose cells span [clo, chi] per axis: the longest extent, ties to
+ * the outermost (whose slabs are contiguous blocks of nodes); p2g.c slabs along it, sort.c
+ * puts it outermost in its key. */
+static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
+  int ax = dim - 1;
+  for (int a = dim - 2; a >= 0; --a)
+    if (chi[a] - clo[a] > chi[ax] - clo[ax]) ax = a;
+  return ax;
+}
 
 /* The step's kernel phases (p2g.c, grid_update.c, g2p.c, fbar.c) exist once per instruction
  * set: CMakeLists.txt compiles these four files a second time for x86-64-v3 (AVX2) with

@@ -73,11 +73,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     sim->nslab = 0;
     return MPMC_SUCCESS;
   }
-  /* slab axis: the longest extent of the points (ties: the outermost, whose slabs are
-   * contiguous blocks of nodes) */
-  int ax = d - 1;
-  for (int a = d - 2; a >= 0; --a)
-    if (chi[a] - clo[a] > chi[ax] - clo[ax]) ax = a;
+  const int ax = mpmc_slab_axis(d, clo, chi);
 #ifdef _OPENMP
   const int nt = omp_get_max_threads();
 #else

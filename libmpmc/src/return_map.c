@@ -43,12 +43,6 @@ typedef struct {
   mpmc_rm_ws **ws;
 } rm_pool;
 
-double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p) {
-  /* exp(-0) = 1 exactly: points that never yielded (most of a slope) skip the exp */
-  const double x = m->eta * eps_p;
-  return m->kappa_r + (m->kappa_p - m->kappa_r) * (x == 0.0 ? 1.0 : exp(-x));
-}
-
 /* The unknown is the returned von Mises stress y = q_trial - 3G dgamma, in [kappa_r,
  * kappa(eps_p)].  The residual r(y) = y - kappa(eps_p + (q_trial - y)/3G) equals
  * g(dgamma) but is formed from numbers of the size of kappa, so it can be driven to
@@ -191,9 +185,6 @@ static int solve_kinsol(mpmc_rm_ws *ws, const mpmc_j2_param *m, double qtr, doub
   return MPMC_SUCCESS;
 }
 
-/* Newton on the bracket [lo, hi] of y, from hi (the perfect-plasticity predictor
- * y = kappa(eps_p)).  strict = 1 (auto): return 1 ("stiff") instead of safeguarding;
- * strict = 0 (newton): bisect whenever the Newton step leaves the bracket. */
 /* exp(-x) for the small x of Newton's iterates (x = eta dgamma: a step's plastic increment
  * times the softening rate, mostly < 1e-2): Horner to x^6 / 6!, the tail below 2e-18 of the
  * value; libm's exp beyond. */
@@ -213,11 +204,13 @@ static inline double rm_r_k(const mpmc_j2_param *m, double a, double c, double q
   return y - (m->kappa_r + e);
 }
 
-static int solve_newton(const mpmc_j2_param *m, double qtr, double ep0, double tol, int strict,
+/* Newton on the bracket [lo, hi] of y, from hi (the perfect-plasticity predictor
+ * y = kappa(eps_p) = k0).  strict = 1 (auto): return 1 ("stiff") instead of safeguarding;
+ * strict = 0 (newton): bisect whenever the Newton step leaves the bracket. */
+static int solve_newton(const mpmc_j2_param *m, double qtr, double k0, double tol, int strict,
                         double *lo, double *hi, double *y, double *res, mpmc_j2_info *info) {
   double yi = *hi, rprev = INFINITY;
-  const double a = *hi - m->kappa_r, c = m->eta / (3.0 * m->G); /* *hi = kappa(eps_p) here */
-  (void)ep0;
+  const double a = k0 - m->kappa_r, c = m->eta / (3.0 * m->G);
   *res = NAN; /* |r(y)| when the returned y is an evaluated iterate, else NaN */
   for (int it = 0; it < RM_MAX_ITERS; ++it) {
     double dr;
@@ -283,7 +276,7 @@ int mpmc_rm_solve_k(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q
     err = solve_kinsol(ws, m, qtr, ep0, lo, tol, &y, info);
   } else {
     const int stiff =
-        solve_newton(m, qtr, ep0, tol, solver == MPMC_SOLVER_AUTO, &lo, &hi, &y, &res, info);
+        solve_newton(m, qtr, k0, tol, solver == MPMC_SOLVER_AUTO, &lo, &hi, &y, &res, info);
     if (stiff) {
       info->fallback = 1;
       res = NAN;

@@ -13,6 +13,8 @@
 #ifndef MPMC_RETURN_MAP_H
 #define MPMC_RETURN_MAP_H
 
+#include <math.h>
+
 #include "mpmc_impl.h"
 
 /* Material constants the return map needs. */
@@ -49,7 +51,11 @@ void mpmc_rm_ws_destroy(mpmc_rm_ws **ws);
  * MPMC_ERR_MEMORY (KINSOL could not be created).  ws may be NULL for MPMC_SOLVER_NEWTON.
  * On success *dgamma >= 0, *q_new (may be NULL) > 0 and
  * |q_new - kappa(eps_p + dgamma)| <= mpmc_rm_tolerance(). */
-double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p);
+static inline double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p) {
+  /* exp(-0) = 1 exactly: points that never yielded (most of a slope) skip the exp */
+  const double x = m->eta * eps_p;
+  return m->kappa_r + (m->kappa_p - m->kappa_r) * (x == 0.0 ? 1.0 : exp(-x));
+}
 double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p);
 int mpmc_rm_solve(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q_trial,
                   double eps_p, double *dgamma, double *q_new, mpmc_j2_info *info);

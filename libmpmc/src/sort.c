@@ -79,11 +79,9 @@ static void point_keys(const mpmc_sim sim, double *key, double *half, int *clo, 
       clo[a] = c < clo[a] ? c : clo[a];
       chi[a] = c > chi[a] ? c : chi[a];
     }
-  /* axis order, most significant first: the slab axis (p2g.c's rule: the longest extent,
-   * ties to the outermost), then the others from the outermost in */
-  int ax = d - 1;
-  for (int a = d - 2; a >= 0; --a)
-    if (chi[a] - clo[a] > chi[ax] - clo[ax]) ax = a;
+  /* axis order, most significant first: the slab axis (P2G's), then the others from the
+   * outermost in */
+  const int ax = mpmc_slab_axis(d, clo, chi);
   int ord[3], k = 0;
   ord[k++] = ax;
   for (int a = d - 1; a >= 0; --a)
@@ -181,15 +179,10 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
       for (int b = 0; b < sim->bodies->n; ++b) {
         mpmc_body *B = &sim->bodies->b[b];
         if (!B->anchor) continue;
-        if (B->nanchor < n) { /* anchors of points added since the last contact pass */
-          double *an = realloc(B->anchor, sizeof *an * 3 * (size_t)n);
-          if (!an) {
-            free(own);
-            return MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "sort: cannot grow the friction anchors");
-          }
-          for (size_t i = 3 * (size_t)B->nanchor; i < 3 * (size_t)n; ++i) an[i] = NAN;
-          B->anchor = an;
-          B->nanchor = n;
+        const int e = mpmc_contact_grow_anchors(sim, B); /* points added since the last pass */
+        if (e) {
+          free(own);
+          return e;
         }
         permute_doubles(B->anchor, 3, perm, n, tmp, w);
       }

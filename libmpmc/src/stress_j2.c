@@ -159,8 +159,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         if (!act[l]) continue;
         const int q = q0 + l;
         double *ep = p->eps_p + q;
-        const double x = par.eta * *ep;
-        const double k0 = par.kappa_r + (par.kappa_p - par.kappa_r) * (x == 0.0 ? 1.0 : exp(-x));
+        const double k0 = mpmc_j2_kappa(&par, *ep);
         const double qtr = sqrt(q2[l]) * G2;
         double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
         double tau[6], J;
@@ -176,8 +175,6 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           /* plastic: the scalar solve and b_e from this trial state */
           double bl[6], el[6];
           for (int k = 0; k < 6; ++k) bl[k] = bt[k][l], el[k] = e[k][l];
-          info.q_trial = qtr;
-          info.kappa = k0;
           err = mpmc_j2_plastic(w, solver, &par, bl, el, tr[l], qtr, k0, be, ep, tau, NULL, &info);
           J = sqrt(detb[l]); /* = exp(tr eps): the flow is isochoric */
         } else { /* outside the series or not finite: the scalar map from b_e^n and dF */
