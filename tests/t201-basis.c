@@ -103,11 +103,48 @@ static void test_known_values(void **state) {
   TCLOSE(w[0], 0.0625, 1e-15); /* (1 + l - 1)^2/(4 l) = l/4 */
 }
 
+/* formulas.md's uGIMP weight in its four pieces (cell units: distance x, half-length l) */
+static double ugimp_ref(double x, double l) {
+  const double a = fabs(x);
+  if (a >= 1.0 + l) return 0.0;
+  if (a > 1.0 - l) return (1.0 + l - a) * (1.0 + l - a) / (4.0 * l);
+  if (a > l) return 1.0 - a;
+  return 1.0 - (x * x + l * l) / (2.0 * l);
+}
+
+/* The library's uGIMP weights (basis.h computes them without branches, as an average of the
+ * hat) against the pieces: to round-off, and to 1e-7 of themselves in the support's tails,
+ * down to weights of 1e-15, where a node reached only by a tail divides a force by a mass ~ w
+ * (an absolute error of 1e-17 in such a weight, which subtracting the hat's antiderivative at
+ * the ends gives, is wrong by its own size there). */
+static void test_ugimp_reference(void **state) {
+  (void)state;
+  unsigned seed = 99u;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double l = 0.02 + 0.48 * urand(&seed);
+    double s = 10.0 + urand(&seed);
+    if (trial % 2) { /* node 0 in its tail: s - b = f = 1 + l - delta */
+      const double delta = pow(10.0, -2.0 - 5.0 * urand(&seed));
+      s = 10.0 + (1.0 + l - delta);
+    }
+    int base;
+    double w[MPMC_MAX_STENCIL], dw[MPMC_MAX_STENCIL];
+    mpmc_basis_eval_1d(MPMC_BASIS_UGIMP, s, l, 1.0, &base, w, dw);
+    for (int k = 0; k < 3; ++k) {
+      const double ref = ugimp_ref(s - (base + k), l);
+      if (!(fabs(w[k] - ref) <= 1e-7 * ref + 1e-300 && fabs(w[k] - ref) <= 1e-14))
+        fail_msg("uGIMP s = %.17g, l = %.17g, node %d: w = %.17g, formulas.md %.17g", s, l, k, w[k], ref);
+    }
+    if (w[3] != 0.0 || dw[3] != 0.0) fail_msg("uGIMP: the fourth lane is %g, %g (expected 0)", w[3], dw[3]);
+  }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_bases_2d),
       cmocka_unit_test(test_bases_3d),
       cmocka_unit_test(test_known_values),
+      cmocka_unit_test(test_ugimp_reference),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

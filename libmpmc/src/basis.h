@@ -5,6 +5,7 @@
 #define MPMC_BASIS_H
 
 #include <math.h>
+#include <string.h>
 
 #include "mpmc.h"
 
@@ -23,24 +24,21 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
   return basis == MPMC_BASIS_LINEAR ? 2 : basis == MPMC_BASIS_BSPLINE3 ? 4 : 3;
 }
 
-/* uGIMP weight of a node at cell-unit distance x from a point of half-length l (cell units). */
-MPMC_ALWAYS_INLINE void mpmc_ugimp_1d(double x, double l, double *w, double *dw) {
-  const double a = fabs(x), sg = x < 0 ? -1.0 : 1.0;
-  if (a >= 1.0 + l) {
-    *w = 0.0;
-    *dw = 0.0;
-  } else if (a > 1.0 - l) {
-    const double r = 1.0 + l - a;
-    *w = r * r / (4.0 * l);
-    *dw = -sg * r / (2.0 * l);
-  } else if (a > l) {
-    *w = 1.0 - a;
-    *dw = -sg;
-  } else {
-    *w = 1.0 - (x * x + l * l) / (2.0 * l);
-    *dw = -x / l;
-  }
-}
+/* uGIMP, branch-free: the weight of a node at cell-unit distance x from a point of
+ * half-length l (cell units, 0 < l <= 1/2) is the hat N(y) = max(0, 1 - |y|) averaged over
+ * the point, w = (1/2l) int_{x-l}^{x+l} N.  With u, v = x + l, x - l clamped to [-1, 1] (N is 0
+ * beyond) the integrand is linear on [v, u] but for the kink at 0, so
+ *   w = [(u - v) (N(u) + N(v)) / 2 + max(0, -u v)] / (2l),   w' = (N(u) - N(v)) / (2l)
+ * (trapezoid plus the kink's share).  In this form a weight near the support's ends keeps
+ * its relative accuracy (u - v and 1 - |u| are exact there), which matters: a node reached
+ * only by such a tail divides a force ~ w' by a mass ~ w, and the antiderivative's difference
+ * H(u) - H(v), whose absolute rounding error is 1e-17, inverted a point of the 2D Cook membrane.
+ * The same values as formulas.md's four pieces (t201 compares them), without the branches
+ * whose outcome changes from point to point.  Written over MPMC_MAX_STENCIL lanes (the fourth
+ * node, at x <= -3/2, gets exactly 0, as do nodes outside the support) so that the loop
+ * becomes whole vectors. */
+typedef double mpmc_b4d __attribute__((vector_size(4 * sizeof(double))));
+typedef long long mpmc_b4l __attribute__((vector_size(4 * sizeof(long long))));
 
 /* Weights w[k] and gradients dw[k] (d/dx_p, per metre) of nodes base..base+S-1 along one
  * axis.  s = (x_p - origin)/h; l = uGIMP half-length / h. */
@@ -86,14 +84,31 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       dw[3] = 0.5 * x3 * x3 * inv_h;
       break;
     }
-    default: { /* MPMC_BASIS_UGIMP, requires l <= 1/2 */
+    default: { /* MPMC_BASIS_UGIMP, requires 0 < l <= 1/2 (above) */
       const int b = mpmc_ifloor(s - 0.5);
       const double f = s - b;
+      const double i2l = 0.5 / l, gi2l = i2l * inv_h;
       *base = b;
-      for (int k = 0; k < 3; ++k) {
-        mpmc_ugimp_1d(f - k, l, &w[k], &dw[k]);
-        dw[k] *= inv_h;
-      }
+      const mpmc_b4d x = f - (mpmc_b4d){0.0, 1.0, 2.0, 3.0}, one = x * 0.0 + 1.0;
+      const mpmc_b4l sign = (mpmc_b4l)(-(one * 0.0)); /* -0.0: the sign bits */
+      mpmc_b4d u = x + l, v = x - l;
+      /* clamp to [-1, 1] exactly (outside the support both ends clamp alike and w = dw = 0) */
+      mpmc_b4l m = u > one;
+      u = (mpmc_b4d)((m & (mpmc_b4l)one) | (~m & (mpmc_b4l)u));
+      m = u < -one;
+      u = (mpmc_b4d)((m & (mpmc_b4l)(-one)) | (~m & (mpmc_b4l)u));
+      m = v > one;
+      v = (mpmc_b4d)((m & (mpmc_b4l)one) | (~m & (mpmc_b4l)v));
+      m = v < -one;
+      v = (mpmc_b4d)((m & (mpmc_b4l)(-one)) | (~m & (mpmc_b4l)v));
+      const mpmc_b4d nu = one - (mpmc_b4d)((mpmc_b4l)u & ~sign); /* N(u) = 1 - |u| */
+      const mpmc_b4d nv = one - (mpmc_b4d)((mpmc_b4l)v & ~sign);
+      const mpmc_b4d uv = u * v;
+      const mpmc_b4d kink = (mpmc_b4d)((uv < x * 0.0) & (mpmc_b4l)(-uv));
+      const mpmc_b4d wv = ((u - v) * (nu + nv) * 0.5 + kink) * i2l;
+      const mpmc_b4d dv = (nu - nv) * gi2l;
+      memcpy(w, &wv, sizeof wv);
+      memcpy(dw, &dv, sizeof dv);
       break;
     }
   }
