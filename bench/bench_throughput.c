@@ -10,7 +10,8 @@
  * every N steps (mpmc_sim_set_sort_interval; the first warm-up step sorts).  With MPMC_BENCH_CPU set in
  * the environment the rates are per second of the process's CPU time (all threads) instead
  * of wall-clock time: on a shared, loaded machine that is the steadier measure of the code's
- * cost. */
+ * cost.  With MPMC_BENCH_PHASES set each row is followed by the share of the step's wall time
+ * per phase (mpmc_stats.phase_seconds) of its last run. */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -40,6 +41,7 @@ static double bytes_per_point(const mpmc_sim sim) {
 }
 static double last_bytes;
 static int shuffle_points, sort_every, use_cpu_time;
+static double last_phase[MPMC_PHASE_COUNT]; /* the last run's share of the step per phase */
 
 static double now(void) {
   struct timespec ts;
@@ -109,9 +111,14 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
   double dt;
   CHECK(mpmc_sim_stable_dt(sim, 0.3, &dt));
   for (int s = 0; s < 3; ++s) CHECK(mpmc_sim_step(sim, dt)); /* warm-up: allocations */
+  mpmc_stats st0, st1;
+  CHECK(mpmc_sim_get_stats(sim, &st0));
   const double t0 = now();
   for (int s = 0; s < steps; ++s) CHECK(mpmc_sim_step(sim, dt));
   const double t = now() - t0;
+  CHECK(mpmc_sim_get_stats(sim, &st1));
+  for (int k = 0; k < MPMC_PHASE_COUNT; ++k)
+    last_phase[k] = (st1.phase_seconds[k] - st0.phase_seconds[k]) / (st1.wall_seconds - st0.wall_seconds);
   last_bytes = bytes_per_point(sim);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
@@ -126,6 +133,7 @@ int main(int argc, char **argv) {
   shuffle_points = argc > 5 ? atoi(argv[5]) : 0;
   sort_every = argc > 6 ? atoi(argv[6]) : 0;
   use_cpu_time = getenv("MPMC_BENCH_CPU") != NULL;
+  const int phases = getenv("MPMC_BENCH_PHASES") != NULL;
   const char *bn[4] = {"linear", "ugimp", "bspline2", "bspline3"};
   const char *fb[4] = {"off", "paper", "total", "stable"};
   struct {
@@ -154,6 +162,13 @@ int main(int argc, char **argv) {
     printf("%-7s %-9s %-5s %-10s %9d %14.3f %14.3f %8.2f %7.0f\n", cases[c].scene ? "column" : "block",
            bn[cases[c].basis], fb[cases[c].fbar], cases[c].j2 ? "hencky_j2" : "hencky", np, r1 / 1e6,
            r2 / 1e6, r2 / r1, last_bytes);
+    if (phases) { /* the last run's (the 2-thread one when both ran) */
+      static const char *const ph[MPMC_PHASE_COUNT] = {"sort", "slabs", "p2g",    "grid",
+                                                       "g2p",  "fbar",  "stress", "checks"};
+      printf("  phases (%% of the step):");
+      for (int k = 0; k < MPMC_PHASE_COUNT; ++k) printf(" %s %.1f", ph[k], 100 * last_phase[k]);
+      printf("\n");
+    }
     fflush(stdout);
   }
   return 0;

@@ -52,6 +52,10 @@ module mpmc
     MPMC_FIELD_MASS = 2, MPMC_FIELD_VOLUME0 = 3, MPMC_FIELD_J = 4, MPMC_FIELD_JBAR = 5, &
     MPMC_FIELD_STRESS = 6, MPMC_FIELD_BE = 7, MPMC_FIELD_EPS_P = 8, MPMC_FIELD_FORCE = 9, &
     MPMC_FIELD_X0 = 10, MPMC_FIELD_COUNT = 11
+  ! phases of a step: stats%phase_seconds(MPMC_PHASE_P2G) (indexed from 0, as in C)
+  integer(c_int), parameter, public :: MPMC_PHASE_SORT = 0, MPMC_PHASE_SLABS = 1, &
+    MPMC_PHASE_P2G = 2, MPMC_PHASE_GRID = 3, MPMC_PHASE_G2P = 4, MPMC_PHASE_FBAR = 5, &
+    MPMC_PHASE_STRESS = 6, MPMC_PHASE_CHECKS = 7, MPMC_PHASE_COUNT = 8
   ! seeding from gmsh
   integer(c_int), parameter, public :: MPMC_SEED_LATTICE = 0, MPMC_SEED_QUADRATURE = 1
   ! mpmc_workflow_run flags
@@ -79,6 +83,9 @@ module mpmc
     integer(c_int64_t) :: return_maps = 0
     integer(c_int64_t) :: kinsol_fallbacks = 0
     real(c_double) :: wall_seconds = 0
+    !> wall_seconds by phase, indexed by MPMC_PHASE_* (sort, slabs, p2g, grid, g2p, fbar,
+    !> stress, checks)
+    real(c_double) :: phase_seconds(0:7) = 0
   end type mpmc_stats
 
   !> A user material's stress update (mpmc_user_stress_fn).  Called from several threads at

@@ -162,10 +162,15 @@ static void compare(const result *a, const result *b, const char *what) {
   if (a->n != b->n) fail_msg("%s: %d against %d points", what, a->n, b->n);
   for (int k = 0; k < NF; ++k) {
     if (a->nc[k] != b->nc[k]) fail_msg("%s: field %s present in one run only", what, name[k]);
+    /* 1e-7 of the field's largest value: most cases agree to 1e-12, but the 3D linear one
+     * (a third of the time step, points crossing into empty cells, yield reached) amplifies
+     * the nodes' summation order to 1e-9 .. 1e-8 (2.1e-9 of eps_p before the slabs went by
+     * plane, 1.0e-8 after); a sort that leaves a field behind errs by far more (be not
+     * permuted: x off by 1.5e-4 of its largest value, first case) */
     double scale = 0;
     for (size_t i = 0; i < (size_t)a->n * a->nc[k]; ++i) scale = fmax(scale, fabs(a->f[k][i]));
     for (size_t i = 0; i < (size_t)a->n * a->nc[k]; ++i)
-      if (!(fabs(a->f[k][i] - b->f[k][i]) <= 1e-8 * scale + 1e-300))
+      if (!(fabs(a->f[k][i] - b->f[k][i]) <= 1e-7 * scale + 1e-300))
         fail_msg("%s: %s of point id %zu component %zu: %.17g sorted, %.17g unsorted (scale %g)",
                  what, name[k], i / a->nc[k], i % a->nc[k], a->f[k][i], b->f[k][i], scale);
   }

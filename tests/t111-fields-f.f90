@@ -15,6 +15,7 @@ program t111_fields_f
   integer(c_int), pointer :: ids(:), idx(:), nodes(:, :)
   character(len=:), allocatable :: name
   type(c_ptr) :: px
+  type(mpmc_stats) :: st
   integer :: nfail
 
   nfail = 0
@@ -65,6 +66,14 @@ program t111_fields_f
   call ok(mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, s), 'get stress')
   call expect_int('stress rows', 6, size(s, 1))
   call expect_close('max |stress| of a rigid translation', 0.0_c_double, maxval(abs(s)), 1.0e-6_c_double)
+  ! the statistics as C fills them: one step of 4 points, its wall time split by phase
+  call ok(mpmc_sim_get_stats(sim, st), 'stats')
+  call expect_int('stats steps', 1, int(st%steps, c_int))
+  call expect_int('stats particle steps', 4, int(st%particle_steps, c_int))
+  call check(st%phase_seconds(MPMC_PHASE_P2G) > 0 .and. all(st%phase_seconds >= 0), &
+    'phase times >= 0, P2G''s > 0')
+  call expect_close('sum of the phase times', st%wall_seconds, sum(st%phase_seconds), &
+    1.0e-9_c_double*st%wall_seconds)
   call ok(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, v), 'restore velocity')
   call ok(mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, x), 'restore position')
   call check(.not. associated(x), 'restore nullifies the rank-2 pointer')

@@ -80,6 +80,19 @@ static void compare(mpmc_sim a, mpmc_sim b) {
   TCALL(mpmc_sim_get_stats(b, &sb));
   assert_int_equal(sa.steps, sb.steps);
   assert_int_equal(sa.particle_steps, sb.particle_steps);
+  /* the step's wall time is the sum of its phases' (the checkpoint carries both) */
+  const mpmc_stats *st[2] = {&sa, &sb};
+  for (int r = 0; r < 2; ++r) {
+    double sum = 0;
+    for (int k = 0; k < MPMC_PHASE_COUNT; ++k) {
+      if (!(st[r]->phase_seconds[k] >= 0)) fail_msg("phase %d: %g s", k, st[r]->phase_seconds[k]);
+      sum += st[r]->phase_seconds[k];
+    }
+    if (!(st[r]->phase_seconds[MPMC_PHASE_P2G] > 0)) fail_msg("P2G took no time");
+    if (!(fabs(sum - st[r]->wall_seconds) <= 1e-9 * st[r]->wall_seconds))
+      fail_msg("%s run: phases sum to %.17g s, the steps took %.17g s", r ? "restarted" : "uninterrupted",
+               sum, st[r]->wall_seconds);
+  }
 }
 
 static void test_restart_bitwise(void **state) {

@@ -105,6 +105,19 @@ typedef enum {
   MPMC_FIELD_COUNT = 11
 } mpmc_field;
 
+/* The phases of a step, as mpmc_stats.phase_seconds counts their wall time. */
+typedef enum {
+  MPMC_PHASE_SORT = 0,    /* sorting the points by cell (mpmc_sim_set_sort_interval)     */
+  MPMC_PHASE_SLABS = 1,   /* clearing the grid, the points' slabs (P2G's colouring)       */
+  MPMC_PHASE_P2G = 2,     /* mass, momentum and forces onto the grid                     */
+  MPMC_PHASE_GRID = 3,    /* grid velocities, walls, damping                             */
+  MPMC_PHASE_G2P = 4,     /* velocities, deformation, positions (with F-bar's scatter)   */
+  MPMC_PHASE_FBAR = 5,    /* F-bar's nodal average and gather                             */
+  MPMC_PHASE_STRESS = 6,  /* the material update                                         */
+  MPMC_PHASE_CHECKS = 7,  /* stability limit, rigid bodies' contact, run monitor         */
+  MPMC_PHASE_COUNT = 8
+} mpmc_phase;
+
 /* Run statistics, accumulated since creation. */
 typedef struct {
   int64_t steps;
@@ -113,6 +126,7 @@ typedef struct {
   int64_t return_maps;       /* plastic corrections computed                        */
   int64_t kinsol_fallbacks;  /* return maps the auto solver handed to KINSOL        */
   double wall_seconds;       /* inside mpmc_sim_step                                */
+  double phase_seconds[MPMC_PHASE_COUNT]; /* wall_seconds by phase (mpmc_phase)      */
 } mpmc_stats;
 
 /* ---- errors and context ------------------------------------------------------ */

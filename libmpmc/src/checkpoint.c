@@ -70,6 +70,8 @@ static int write_config(hid_t f, const mpmc_sim sim) {
                            stats);
   st |= mpmc_h5_attr_write(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1,
                            &sim->stats.wall_seconds);
+  st |= mpmc_h5_attr_write(g, "stats_phase_seconds", H5T_NATIVE_DOUBLE, MPMC_PHASE_COUNT,
+                           sim->stats.phase_seconds);
   const int64_t sort[2] = {sim->sort_every, sim->sort_last}; /* interval, step of the last */
   st |= mpmc_h5_attr_write(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
   H5Gclose(g);
@@ -96,6 +98,9 @@ static int read_config(hid_t f, mpmc_sim sim) {
   st |= mpmc_h5_attr_read(g, "stats_steps_particlesteps_returnmaps_kinsol", H5T_NATIVE_INT64, 4,
                           stats);
   st |= mpmc_h5_attr_read(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1, &wall);
+  double phase[MPMC_PHASE_COUNT] = {0}; /* absent in files of before the phase timers */
+  if (H5Aexists(g, "stats_phase_seconds") > 0)
+    st |= mpmc_h5_attr_read(g, "stats_phase_seconds", H5T_NATIVE_DOUBLE, MPMC_PHASE_COUNT, phase);
   int64_t sort[2] = {0, -1}; /* absent in files of before the sort: never sorted */
   if (H5Aexists(g, "sort_interval_last") > 0)
     st |= mpmc_h5_attr_read(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
@@ -122,6 +127,7 @@ static int read_config(hid_t f, mpmc_sim sim) {
   sim->stats.return_maps = stats[2];
   sim->stats.kinsol_fallbacks = stats[3];
   sim->stats.wall_seconds = wall;
+  for (int k = 0; k < MPMC_PHASE_COUNT; ++k) sim->stats.phase_seconds[k] = phase[k];
   MPMC_CHECK(sort[0] >= 0 && sort[0] <= INT32_MAX && sort[1] >= -1 && sort[1] <= stats[0], ctx,
              MPMC_ERR_FORMAT, "checkpoint /config: bad sort_interval_last = [%lld, %lld]",
              (long long)sort[0], (long long)sort[1]);

@@ -1,6 +1,7 @@
 /* Particle to grid: mass (eq 7), momentum (eq 8), internal force (eq 10) and the points'
  * external forces.  Threads scatter without atomics: the points are bucketed by slab
  * (mpmc_slabs_build) and the slabs of one parity run in parallel, then the other parity. */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #ifdef _OPENMP
@@ -9,76 +10,113 @@
 
 #include "transfer.h"
 
-/* Bucket the points into slabs of whole cell planes along one axis (a stable counting sort
- * of indices; the particle arrays themselves are not moved here: sort.c does that, every
- * sort_interval steps when the caller asks for it), and set the grid's active box to the
- * nodes the points' stencils reach.  Within a slab the points keep their index order: with
- * the points shuffled, visiting them by cell instead (grid in order, particle arrays at
- * random) was slower than this (particle arrays in order, grid at random) on the 3D column.
+/* Bucket the points into slabs of whole cell planes along one axis (a counting sort of
+ * indices, by plane and within a plane by index; the particle arrays themselves are not
+ * moved here: sort.c does that, every sort_interval steps when the caller asks for it), and
+ * set the grid's active box to the nodes the points' stencils reach.  Visiting the points
+ * of a slab in index order (particle arrays in order, grid at random when the points are
+ * shuffled) was faster than by cell (grid in order, particle arrays at random) on the 3D
+ * column; sorted points are in both orders at once.
  * Slabs of one parity run in parallel: a point in cell c touches nodes c-1 .. c+2 at most
  * (cubic), so two slabs with one slab of at least MPMC_SLAB_W = 3 cells between them share no
  * node.  The slab boundaries balance the points: about 2 x threads slabs or a multiple, so
  * each thread gets the same share of each colour (fixed-width slabs left one of two threads
  * idle for a third of P2G in the 3D column).  Results depend on the thread count only
- * through the summation order at the nodes that two slabs share. */
+ * through the summation order at the nodes that two slabs share.
+ * Both passes over the points run on all threads, each over a fixed chunk of them: the
+ * first finds the box and counts the points per plane of the slab axis (the last step's
+ * axis; counted again in the rare step where the box's longest extent changes axis), the
+ * second places them.  Each point's plane is kept in between in dF, which is free from the
+ * end of one step's material update until its G2P (sort.c uses it likewise).  The order
+ * does not depend on the chunks, so neither on the thread count. */
 int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim, n = p->n;
   const double ih = g->inv_h;
+  if (n == 0) {
+    for (int a = 0; a < 3; ++a) g->act_lo[a] = g->act_hi[a] = 0;
+    sim->nslab = 0;
+    return MPMC_SUCCESS;
+  }
+  MPMC_CHECK(p->dF, sim->ctx, MPMC_ERR_STATE, "slabs: the points' fields are not allocated");
   if (n > sim->cap_order) {
     int *o = realloc(sim->order, sizeof(int) * (size_t)n);
     MPMC_CHECK(o, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the slab order of %d points", n);
     sim->order = o;
     sim->cap_order = n;
   }
-  /* one pass over the points: the cells holding points, and how many lie in each plane of
-   * cells along every axis (the points stay within one cell of the box, g2p checks, well
-   * inside the ghost layers, so the cell coordinates are positive) */
-  size_t need = 1;
-  for (int a = 0; a < d; ++a) need += 2 * (size_t)g->n[a];
+#ifdef _OPENMP
+  const int nt = omp_get_max_threads();
+#else
+  const int nt = 1;
+#endif
+  const int nc = n > MPMC_OMP_MIN ? nt : 1; /* chunks */
+  int nmax = 1;
+  for (int a = 0; a < d; ++a) nmax = g->n[a] > nmax ? g->n[a] : nmax;
+  /* counts per chunk and plane, [nc][nmax], then the chunks' fill positions; the chunks'
+   * boxes [nc][6] */
+  const size_t need = (size_t)nc * (size_t)nmax + 6 * (size_t)nc;
   if (need > g->cap_ccount) {
     int *c = realloc(g->ccount, sizeof(int) * need);
     MPMC_CHECK(c, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %zu plane counts", need);
     g->ccount = c;
     g->cap_ccount = need;
   }
-  int *hist[3] = {NULL, NULL, NULL}, *fill = g->ccount;
-  for (int a = 0; a < d; ++a) {
-    hist[a] = fill;
-    for (int k = 0; k < g->n[a]; ++k) hist[a][k] = 0;
-    fill += g->n[a];
-  }
+  int *cnt = g->ccount, *box = cnt + (size_t)nc * nmax;
+  int *plane = (int *)(void *)p->dF;
   int clo[3] = {0, 0, 0}, chi[3] = {0, 0, 0};
-  for (int a = 0; a < d; ++a) {
-    clo[a] = g->n[a];
-    chi[a] = -1;
-  }
-  for (int q = 0; q < n; ++q) {
-    const double *x = p->x + (size_t)q * d;
-    for (int a = 0; a < d; ++a) {
-      const int c = (int)((x[a] - g->origin[a]) * ih);
-      clo[a] = c < clo[a] ? c : clo[a];
-      chi[a] = c > chi[a] ? c : chi[a];
-      hist[a][c]++;
+  int ax = sim->slab_axis >= 0 && sim->slab_axis < d ? sim->slab_axis : d - 1;
+  for (int pass = 0; pass < 2; ++pass) {
+    /* the cells holding points (the points stay within one cell of the box, g2p checks, well
+     * inside the ghost layers, so the cell coordinates are positive) and the plane counts */
+#pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
+    for (int t = 0; t < nc; ++t) {
+      int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
+      int *ct = cnt + (size_t)t * nmax;
+      for (int k = 0; k < nmax; ++k) ct[k] = 0;
+      const int q0 = (int)((long long)n * t / nc), q1 = (int)((long long)n * (t + 1) / nc);
+      int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
+      for (int q = q0; q < q1; ++q) {
+        const double *x = p->x + (size_t)q * d;
+        for (int a = 0; a < d; ++a) {
+          const int c = (int)((x[a] - g->origin[a]) * ih);
+          lo[a] = c < lo[a] ? c : lo[a];
+          hi[a] = c > hi[a] ? c : hi[a];
+          if (a == ax) {
+            plane[q] = c;
+            if (c != cur) {
+              if (run) ct[cur] += run;
+              cur = c;
+              run = 0;
+            }
+            ++run;
+          }
+        }
+      }
+      if (run) ct[cur] += run;
+      for (int a = 0; a < 3; ++a) {
+        box[6 * t + a] = lo[a];
+        box[6 * t + 3 + a] = hi[a];
+      }
     }
+    for (int a = 0; a < d; ++a) {
+      clo[a] = INT_MAX;
+      chi[a] = -1;
+      for (int t = 0; t < nc; ++t) {
+        clo[a] = box[6 * t + a] < clo[a] ? box[6 * t + a] : clo[a];
+        chi[a] = box[6 * t + 3 + a] > chi[a] ? box[6 * t + 3 + a] : chi[a];
+      }
+    }
+    const int best = mpmc_slab_axis(d, clo, chi);
+    if (best == ax) break;
+    ax = best; /* the box's longest extent moved to another axis: count along that one */
   }
   for (int a = 0; a < 3; ++a) {
     const int lo = a < d ? clo[a] - 1 : 0, hi = a < d ? chi[a] + 3 : 1;
     g->act_lo[a] = lo < 0 ? 0 : lo;
     g->act_hi[a] = hi > g->n[a] ? g->n[a] : hi;
   }
-  if (n == 0) {
-    for (int a = 0; a < 3; ++a) g->act_lo[a] = g->act_hi[a] = 0;
-    sim->nslab = 0;
-    return MPMC_SUCCESS;
-  }
-  const int ax = mpmc_slab_axis(d, clo, chi);
-#ifdef _OPENMP
-  const int nt = omp_get_max_threads();
-#else
-  const int nt = 1;
-#endif
   const int np = chi[ax] - clo[ax] + 1; /* planes */
   const int per = np / (MPMC_SLAB_W * 2 * nt);
   const double share = (double)n / (2 * nt * (per < 1 ? 1 : per));
@@ -90,25 +128,40 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     sim->cap_slab = cap;
   }
   /* close a slab once it holds its share of the points and is at least MPMC_SLAB_W planes
-   * wide (the last one may be narrower: no slab of its colour lies beyond it); each plane's
-   * count is replaced by its slab */
-  int *start = sim->slab_start, *slab_of = hist[ax] + clo[ax], ns = 0, width = 0, sum = 0;
+   * wide (the last one may be narrower: no slab of its colour lies beyond it); the chunks'
+   * counts become their fill positions: the points of plane pl go after those of the planes
+   * before it, a chunk's after those of the chunks before it */
+  int *start = sim->slab_start, ns = 0, width = 0, sum = 0;
   start[0] = 0;
-  for (int pl = 0; pl < np; ++pl) {
-    sum += slab_of[pl];
-    slab_of[pl] = ns;
+  for (int pl = clo[ax]; pl <= chi[ax]; ++pl) {
+    for (int t = 0; t < nc; ++t) {
+      int *c = cnt + (size_t)t * nmax + pl;
+      const int k = *c;
+      *c = sum;
+      sum += k;
+    }
     ++width;
-    if (pl == np - 1 || (width >= MPMC_SLAB_W && sum >= share * (ns + 1))) {
+    if (pl == chi[ax] || (width >= MPMC_SLAB_W && sum >= share * (ns + 1))) {
       start[++ns] = sum;
       width = 0;
     }
   }
-  /* stable placement */
-  for (int s = 0; s < ns; ++s) fill[s] = start[s];
-  const double o = g->origin[ax];
   int *order = sim->order;
-  for (int q = 0; q < n; ++q)
-    order[fill[slab_of[(int)((p->x[(size_t)q * d + ax] - o) * ih) - clo[ax]]]++] = q;
+#pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
+  for (int t = 0; t < nc; ++t) {
+    int *fill = cnt + (size_t)t * nmax;
+    const int q0 = (int)((long long)n * t / nc), q1 = (int)((long long)n * (t + 1) / nc);
+    int cur = plane[q0], pos = fill[cur];
+    for (int q = q0; q < q1; ++q) {
+      const int pl = plane[q];
+      if (pl != cur) {
+        fill[cur] = pos;
+        cur = pl;
+        pos = fill[pl];
+      }
+      order[pos++] = q;
+    }
+  }
   sim->nslab = ns;
   sim->slab_axis = ax;
   return MPMC_SUCCESS;
@@ -203,11 +256,10 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS, 
   }
 MPMC_KERNELS(P2G_KERNEL)
 
-/** Phase 1 of the step: reset the grid and scatter the points onto it. */
+/** Phase 1 of the step: scatter the points onto the grid, after the step has cleared the
+ * last step's box and built this step's slabs (mpmc_slabs_build). */
 int MPMC_ISA(mpmc_p2g)(mpmc_sim sim, double dt) {
   (void)dt;
-  mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
-  MPMC_CALL(MPMC_ISA(mpmc_slabs_build)(sim));    /* ... and this step's box */
   MPMC_KERNEL_CALL(p2g_, sim, sim);
   return MPMC_SUCCESS;
 }

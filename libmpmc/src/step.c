@@ -15,30 +15,46 @@ static double now(void) {
 
 /* The kernel phases for each instruction set (mpmc_impl.h, mpmc_sim_set_kernels). */
 typedef struct {
+  int (*slabs)(mpmc_sim);
   int (*p2g)(mpmc_sim, double);
   int (*grid_update)(mpmc_sim, double);
   int (*g2p)(mpmc_sim, double);
   int (*fbar)(mpmc_sim);
 } kernel_set;
-static const kernel_set baseline = {mpmc_p2g, mpmc_grid_update, mpmc_g2p, mpmc_fbar};
+static const kernel_set baseline = {mpmc_slabs_build, mpmc_p2g, mpmc_grid_update, mpmc_g2p,
+                                    mpmc_fbar};
 #ifdef MPMC_HAVE_AVX2_KERNELS
-static const kernel_set avx2 = {mpmc_p2g_avx2, mpmc_grid_update_avx2, mpmc_g2p_avx2,
-                                mpmc_fbar_avx2};
+static const kernel_set avx2 = {mpmc_slabs_build_avx2, mpmc_p2g_avx2, mpmc_grid_update_avx2,
+                                mpmc_g2p_avx2, mpmc_fbar_avx2};
 #define KERNELS(sim) ((sim)->kernels == MPMC_KERNELS_AVX2 ? &avx2 : &baseline)
 #else
 #define KERNELS(sim) (&baseline)
 #endif
 
-static int step_phases(mpmc_sim sim, double dt) {
+/* The wall time since *t goes to phase ph; *t becomes now. */
+static void lap(mpmc_sim sim, int ph, double *t) {
+  const double t1 = now();
+  sim->stats.phase_seconds[ph] += t1 - *t;
+  *t = t1;
+}
+#define PHASE(sim, ph, t, call) \
+  do {                          \
+    MPMC_CALL(call);            \
+    lap(sim, ph, t);            \
+  } while (0)
+
+static int step_phases(mpmc_sim sim, double dt, double *t) {
   const kernel_set *k = KERNELS(sim);
-  if (sim->bodies) MPMC_CALL(mpmc_contact_update(sim, dt)); /* barrier forces on points */
-  MPMC_CALL(k->p2g(sim, dt));            /* mass, momentum, forces      (eqs 7, 8, 10) */
-  MPMC_CALL(k->grid_update(sim, dt));    /* velocities, walls, damping  (eq 9)         */
-  MPMC_CALL(k->g2p(sim, dt));            /* v, dF, J, x                 (eqs 13-17)    */
-  if (sim->fbar) MPMC_CALL(k->fbar(sim)); /* dF -> dF-bar               (Alg. 1, 2-4)  */
-  MPMC_CALL(mpmc_stress_update(sim, dt)); /* material update with dF(-bar)             */
+  if (sim->bodies) PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_update(sim, dt)); /* barrier forces */
+  mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
+  PHASE(sim, MPMC_PHASE_SLABS, t, k->slabs(sim));     /* this step's box, P2G's colouring */
+  PHASE(sim, MPMC_PHASE_P2G, t, k->p2g(sim, dt));     /* mass, momentum, forces   (eqs 7, 8, 10) */
+  PHASE(sim, MPMC_PHASE_GRID, t, k->grid_update(sim, dt)); /* velocities, walls, damping (eq 9) */
+  PHASE(sim, MPMC_PHASE_G2P, t, k->g2p(sim, dt));     /* v, dF, J, x              (eqs 13-17)    */
+  if (sim->fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim)); /* dF -> dF-bar (Alg. 1, 2-4) */
+  PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar) */
   if (sim->bodies) MPMC_CALL(mpmc_contact_check(sim)); /* no point inside a rigid body */
-  MPMC_CALL(mpmc_monitor_step(sim)); /* NaN velocity, energy growth (monitor.c)         */
+  PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_monitor_step(sim)); /* NaN velocity, energy growth */
   return MPMC_SUCCESS;
 }
 
@@ -60,6 +76,8 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   if (sim->nthreads > 0) omp_set_num_threads(sim->nthreads);
 #endif
   int err = MPMC_SUCCESS;
+  const double t0 = now();
+  double t = t0;
   if (!sim->force_dt) {
     const double limit = mpmc_stability_limit(sim, 1.0);
     if (!(dt <= limit))
@@ -68,9 +86,10 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
                        "<= %g (factor 0.3-0.4) or force it",
                        dt, limit, sim->grid.h, limit);
   }
-  const double t0 = now();
+  lap(sim, MPMC_PHASE_CHECKS, &t);
   if (!err) err = mpmc_sort_due(sim); /* locality: points by cell (sort.c), if asked for */
-  if (!err) err = step_phases(sim, dt);
+  lap(sim, MPMC_PHASE_SORT, &t);
+  if (!err) err = step_phases(sim, dt, &t);
 #ifdef _OPENMP
   if (sim->nthreads > 0) omp_set_num_threads(saved);
 #endif
@@ -78,6 +97,6 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   sim->time += dt;
   sim->stats.steps++;
   sim->stats.particle_steps += sim->p.n;
-  sim->stats.wall_seconds += now() - t0;
+  sim->stats.wall_seconds += t - t0; /* the sum of the phases */
   return MPMC_SUCCESS;
 }
