@@ -2,7 +2,8 @@
  * scripts/check-tsan): a 2D and a 3D scene above MPMC_OMP_MIN points (so P2G, G2P, F-bar, the
  * stress update and the monitor run their parallel loops) stepped on 1 and on 2 threads;
  * positions, velocities, stresses and J agree to round-off (the scatter sums in another
- * order), and neither run trips the monitor. */
+ * order), and neither run trips the monitor; also a compact body, whose threads scatter into
+ * grids of their own. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -22,7 +23,9 @@ typedef struct {
   double *x, *v, *s, *J;
 } snap;
 
-static void run(int dim, int nthreads, int fbar, int basis, snap *out) {
+/* compact: a 0.6 m cube at 27 points per cell, six cell planes along every axis: two slabs,
+ * so the threads scatter into grids of their own (p2g.c, private_grids) */
+static void run(int dim, int nthreads, int fbar, int basis, int compact, snap *out) {
   mpmc_context ctx;
   mpmc_sim sim;
   TCALL(mpmc_context_create(&ctx));
@@ -30,14 +33,16 @@ static void run(int dim, int nthreads, int fbar, int basis, snap *out) {
   TCALL(mpmc_sim_create(ctx, dim, &sim));
   const double h = dim == 2 ? 0.02 : 0.1;
   const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1};
-  const double blo[3] = {0, 0, 0}, bhi[3] = {dim == 2 ? 1.3 : 1.0, 0.7, 0.8};
+  const double blo[3] = {0, 0, 0};
+  double bhi[3] = {dim == 2 ? 1.3 : 1.6, 0.7, 0.8}; /* 3D: four even slabs, two colours */
+  if (compact) bhi[0] = bhi[1] = bhi[2] = 0.6;
   TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
   TCALL(mpmc_sim_set_basis(sim, basis));
   TCALL(mpmc_sim_set_fbar(sim, fbar));
   TCALL(mpmc_sim_set_threads(sim, nthreads));
   int mat, n;
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e6, 0.45, 2000, 8e3, 2e3, 50, &mat));
-  TCALL(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, &n));
+  TCALL(mpmc_sim_seed_box(sim, blo, bhi, compact ? 3 : 2, mat, NULL, &n));
   if (n <= 4096) fail_msg("expected more than MPMC_OMP_MIN = 4096 points, got %d", n);
   for (int f = 0; f < 2 * dim; ++f)
     if (f != 1) TCALL(mpmc_sim_add_wall_face(sim, f, f == 2 ? MPMC_WALL_FIXED : MPMC_WALL_SLIP, NULL));
@@ -46,6 +51,10 @@ static void run(int dim, int nthreads, int fbar, int basis, snap *out) {
   double dt;
   TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
   for (int s = 0; s < 8; ++s) TCALL(mpmc_sim_step(sim, dt));
+  const int expect = compact && nthreads == 2 ? 2 : 0;
+  if (sim->grid.nprivate != expect)
+    fail_msg("P2G on %d threads: per-thread grids %d, expected %d (%d slabs)", nthreads,
+             sim->grid.nprivate, expect, sim->nslab);
   double *f;
   out->n = n;
   const int fields[4] = {MPMC_FIELD_POSITION, MPMC_FIELD_VELOCITY, MPMC_FIELD_STRESS, MPMC_FIELD_J};
@@ -67,10 +76,10 @@ static void compare(const char *what, const double *a, const double *b, size_t l
                1e-9 * scale);
 }
 
-static void check(int dim, int fbar, int basis) {
+static void check(int dim, int fbar, int basis, int compact) {
   snap one, two;
-  run(dim, 1, fbar, basis, &one);
-  run(dim, 2, fbar, basis, &two);
+  run(dim, 1, fbar, basis, compact, &one);
+  run(dim, 2, fbar, basis, compact, &two);
   const size_t n = (size_t)one.n;
   compare("x", one.x, two.x, n * dim, 1.0);
   compare("v", one.v, two.v, n * dim, 1.0);
@@ -82,21 +91,30 @@ static void check(int dim, int fbar, int basis) {
 
 static void test_2d_fbar(void **state) {
   (void)state;
-  check(2, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2);
+  check(2, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2, 0);
 }
 static void test_2d_ugimp_total(void **state) {
   (void)state;
-  check(2, MPMC_FBAR_TOTAL, MPMC_BASIS_UGIMP);
+  check(2, MPMC_FBAR_TOTAL, MPMC_BASIS_UGIMP, 0);
 }
 static void test_3d_fbar(void **state) {
   (void)state;
-  check(3, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2);
+  check(3, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2, 0);
 }
 
 /* the stable form scatters onto the 2h grid: supports one node wider than the basis' */
 static void test_3d_ugimp_stable(void **state) {
   (void)state;
-  check(3, MPMC_FBAR_STABLE, MPMC_BASIS_UGIMP);
+  check(3, MPMC_FBAR_STABLE, MPMC_BASIS_UGIMP, 0);
+}
+
+/* a body too small for the slabs' colours: per-thread grids in P2G and in G2P's F-bar
+ * scatter (Algorithm 1 and the stable form), without F-bar in P2G alone */
+static void test_3d_compact(void **state) {
+  (void)state;
+  check(3, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2, 1);
+  check(3, MPMC_FBAR_STABLE, MPMC_BASIS_UGIMP, 1);
+  check(3, MPMC_FBAR_OFF, MPMC_BASIS_LINEAR, 1);
 }
 
 /* The slab order of P2G (p2g.c, built for two threads' worth of slabs) is a counting sort by
@@ -173,7 +191,7 @@ static void test_slab_order(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_2d_fbar), cmocka_unit_test(test_2d_ugimp_total),
-                                     cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable),
+                                     cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable), cmocka_unit_test(test_3d_compact),
                                      cmocka_unit_test(test_slab_order)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -23,7 +23,7 @@ typedef struct {
  * the weights of its own space (transfer.h); either way the caller runs the points in slab
  * colours. */
 MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, const int FB,
-                                 double dt, const g2p_ctx *c, int q) {
+                                 double dt, const g2p_ctx *c, double *restrict fb, int q) {
   mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
@@ -80,13 +80,11 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     p->Jbar[q] = jd;
   }
   if (FB == 2) {
-    double *restrict fb = g->fb;
     mpmc_spw sp;
     mpmc_stable_weights(DIM, BASIS, g, p->x + qd, &sp);
     MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
   }
   if (SPLIT || FB == 1) {
-    double *restrict fb = g->fb;
     MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
       mpmc_vd sw[MPMC_NV];
       for (int k = N1; k < NV; ++k) sw[k] = zero;
@@ -120,26 +118,45 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
 
 /* Without F-bar the points run in index order, split evenly among the threads; with it by
  * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
- * fused scatter is race-free. */
+ * fused scatter is race-free, or, when P2G scattered into one grid per thread, in P2G's
+ * chunks, each thread scattering into its own copy of fb. */
 #define G2P_KERNEL(D, B)                                                                     \
   static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {           \
     int first_bad = INT_MAX;                                                                 \
     _Pragma("omp parallel for schedule(static) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
     for (int q = 0; q < sim->p.n; ++q)                                                       \
-      if (!g2p_point(sim, D, B, 0, dt, c, q) && q < first_bad) first_bad = q;                \
+      if (!g2p_point(sim, D, B, 0, dt, c, NULL, q) && q < first_bad) first_bad = q;          \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
   }                                                                                          \
-  static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {         \
+  static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, double *fbp, int nc, \
+                              int *bad) {                                                    \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
     const int fb = sim->fbar == MPMC_FBAR_STABLE ? 2 : 1;                                    \
+    double *fb0 = sim->grid.fb;                                                              \
     int first_bad = INT_MAX;                                                                 \
+    if (fbp) { /* P2G's chunks, each scattering into its own copy (p2g.c) */                 \
+      const size_t per = sim->grid.nn * 2;                                                   \
+      _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) num_threads(nc)") \
+      for (int t = 0; t < nc; ++t) {                                                         \
+        double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                  \
+        const int k1_ = (int)((long long)sim->p.n * (t + 1) / nc);                           \
+        for (int k = (int)((long long)sim->p.n * t / nc); k < k1_; ++k) {                    \
+          const int q_ = order[k];                                                           \
+          const int ok_ = fb == 2 ? g2p_point(sim, D, B, 2, dt, c, f_, q_)                   \
+                                  : g2p_point(sim, D, B, 1, dt, c, f_, q_);                  \
+          if (!ok_ && q_ < first_bad) first_bad = q_;                                        \
+        }                                                                                    \
+      }                                                                                      \
+      *bad = first_bad == INT_MAX ? -1 : first_bad;                                          \
+      return;                                                                                \
+    }                                                                                        \
     for (int colour = 0; colour < 2; ++colour) {                                             \
       _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
         for (int k = start[sl]; k < start[sl + 1]; ++k) {                                    \
           const int q_ = order[k];                                                           \
-          const int ok_ = fb == 2 ? g2p_point(sim, D, B, 2, dt, c, q_)                       \
-                                  : g2p_point(sim, D, B, 1, dt, c, q_);                      \
+          const int ok_ = fb == 2 ? g2p_point(sim, D, B, 2, dt, c, fb0, q_)                  \
+                                  : g2p_point(sim, D, B, 1, dt, c, fb0, q_);                 \
           if (!ok_ && q_ < first_bad) first_bad = q_;                                        \
         }                                                                                    \
     }                                                                                        \
@@ -176,8 +193,12 @@ int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   }
   int bad = -1;
   if (sim->fbar && g->fb) { /* P2G left all of fb zero (mpmc_grid_clear_active) */
-    MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, &bad);
-    sim->grid.fb_done = 1;
+    mpmc_grid *gw = &sim->grid;
+    const int nc = gw->nprivate;
+    double *fbp = nc ? mpmc_grid_copies(gw, &gw->fbpriv, &gw->cap_fbpriv, 2, nc - 1) : NULL;
+    MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, fbp, nc, &bad);
+    if (fbp) mpmc_grid_add_copies(gw, gw->fb, fbp, 2, nc - 1);
+    gw->fb_done = 1;
   } else {
     MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad);
   }

@@ -97,11 +97,45 @@ void mpmc_grid_clear_fb_active(mpmc_grid *g) {
 
 void mpmc_grid_free(mpmc_grid *g) {
   free(g->node);
+  free(g->priv);
   free(g->fb);
   free(g->fixed);
   free(g->ccount);
-  g->node = g->fb = NULL;
+  free(g->fbpriv);
+  g->node = g->fb = g->priv = g->fbpriv = NULL;
   g->fixed = NULL;
   g->ccount = NULL;
-  g->cap_ccount = 0;
+  g->cap_ccount = g->cap_priv = g->cap_fbpriv = 0;
+  g->nprivate = 0;
+}
+
+/* ncopies zeroed copies of a grid array of width doubles per node in *buf (grown as needed;
+ * NULL when they would exceed 256 MiB or cannot be had: the caller then uses its colours) */
+double *mpmc_grid_copies(const mpmc_grid *g, double **buf, size_t *cap, int width, int ncopies) {
+  const size_t len = g->nn * (size_t)width * (size_t)ncopies;
+  if (len * sizeof(double) > ((size_t)256 << 20)) return NULL;
+  if (len > *cap) {
+    free(*buf);
+    *buf = calloc(len, sizeof(double));
+    *cap = *buf ? len : 0;
+  }
+  return *buf;
+}
+
+/* dst += the copies over the active box, in copy order, and the copies back to zero */
+void mpmc_grid_add_copies(const mpmc_grid *g, double *dst, double *copies, int width,
+                          int ncopies) {
+  const size_t per = g->nn * (size_t)width;
+  const long nrow = mpmc_grid_active_rows(g);
+  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]) * (size_t)width;
+#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+  for (long r = 0; r < nrow; ++r) {
+    const size_t first = mpmc_grid_active_row(g, r) * (size_t)width;
+    double *restrict d = dst + first;
+    for (int t = 0; t < ncopies; ++t) {
+      double *restrict src = copies + per * (size_t)t + first;
+      for (size_t i = 0; i < len; ++i) d[i] += src[i];
+      memset(src, 0, len * sizeof(double));
+    }
+  }
 }

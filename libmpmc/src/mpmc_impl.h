@@ -107,6 +107,12 @@ typedef struct {
   int fb_done;         /* G2P scattered this step's F-bar volumes (fused, race-free)     */
   int *ccount;         /* p2g.c scratch: points per plane of cells, slab fill positions   */
   size_t cap_ccount;
+  /* per-thread accumulation (p2g.c, private_grids) when slabs cannot keep the threads busy:
+   * the other threads' copies of node and fb, zero outside the active box; nprivate: this
+   * step's P2G ran that way on nprivate threads (G2P's F-bar scatter follows it) */
+  double *priv, *fbpriv;
+  size_t cap_priv, cap_fbpriv;
+  int nprivate;
   int valid;
 } mpmc_grid;
 
@@ -117,6 +123,9 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar);
 void mpmc_grid_clear(mpmc_grid *g, int with_fbar);
 /* zero the active box only (the hot path: everything outside it is zero already) */
 void mpmc_grid_clear_active(mpmc_grid *g);
+double *mpmc_grid_copies(const mpmc_grid *g, double **buf, size_t *cap, int width, int ncopies);
+void mpmc_grid_add_copies(const mpmc_grid *g, double *dst, double *copies, int width,
+                          int ncopies);
 /* zero the F-bar sums of the active box (the F-bar projection's nodes, in every form) */
 void mpmc_grid_clear_fb_active(mpmc_grid *g);
 void mpmc_grid_free(mpmc_grid *g);

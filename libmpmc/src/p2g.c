@@ -1,6 +1,7 @@
 /* Particle to grid: mass (eq 7), momentum (eq 8), internal force (eq 10) and the points'
  * external forces.  Threads scatter without atomics: the points are bucketed by slab
- * (mpmc_slabs_build) and the slabs of one parity run in parallel, then the other parity. */
+ * (mpmc_slabs_build) and the slabs of one parity run in parallel, then the other parity;
+ * a body too small for that scatters into one grid per thread (private_grids). */
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
@@ -183,11 +184,11 @@ MPMC_ALWAYS_INLINE double rec_slot(const int DIM, int s, double m, const double 
  *                           e = wyz (-V sigma_.0)
  * (grad w = (w_x' wyz, w_x dyz, w_x ydz)), with c and e fixed along the row: per node a few
  * whole-vector multiply-adds on one record. */
-MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
+MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
+                                   double *restrict rec, int q) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
-  double *restrict rec = g->node;
   const size_t qd = (size_t)q * DIM;
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
@@ -245,13 +246,51 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS, 
   });
 }
 
+/* Slabs of two colours keep nt threads busy when each colour splits evenly among them.  A
+ * small body spans too few cell planes for that (the 8,000-point block of bench/: ten planes,
+ * slabs of 3, 3, 3 and 1 planes, so in the second colour one thread scatters 2,400 points
+ * while the other has 800); then the threads scatter nc = nt consecutive chunks of the slab
+ * order each into a grid of their own, chunk 0 into the grid itself, and the copies are added
+ * to it (a race-free scatter by per-thread accumulation).  Taken when the colours would keep
+ * the threads less than 90 % busy (a colour lasts as long as its largest slab or its share per
+ * thread, whichever is longer).  The copies are whole grids, zero outside the active box (they
+ * are cleared over it after each use); not taken when they would exceed 256 MiB. */
+static double *private_grids(mpmc_sim sim, int nt) {
+  mpmc_grid *g = &sim->grid;
+  if (nt < 2 || sim->p.n <= MPMC_OMP_MIN) return NULL;
+  double span = 0.0; /* the colours' duration in points */
+  for (int c = 0; c < 2; ++c) {
+    int total = 0, largest = 0;
+    for (int sl = c; sl < sim->nslab; sl += 2) {
+      const int k = sim->slab_start[sl + 1] - sim->slab_start[sl];
+      total += k;
+      largest = k > largest ? k : largest;
+    }
+    span += fmax((double)largest, (double)total / nt);
+  }
+  if (sim->p.n >= 0.9 * nt * span) return NULL;
+  return mpmc_grid_copies(g, &g->priv, &g->cap_priv, MPMC_NREC, nt - 1);
+}
+
 #define P2G_KERNEL(D, B)                                                                    \
-  static void p2g_##D##_##B(mpmc_sim sim) {                                                 \
+  static void p2g_##D##_##B(mpmc_sim sim, double *priv, int nc) {                           \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;              \
+    double *node = sim->grid.node;                                                          \
+    if (priv) {                                                                             \
+      const size_t per = sim->grid.nn * MPMC_NREC;                                          \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(nc)")                       \
+      for (int t = 0; t < nc; ++t) {                                                        \
+        const int k0 = (int)((long long)sim->p.n * t / nc);                                 \
+        const int k1 = (int)((long long)sim->p.n * (t + 1) / nc);                           \
+        double *rec = t ? priv + per * (size_t)(t - 1) : node;                              \
+        for (int k = k0; k < k1; ++k) p2g_point(sim, D, B, rec, order[k]);                  \
+      }                                                                                     \
+      return;                                                                               \
+    }                                                                                       \
     for (int colour = 0; colour < 2; ++colour) {                                            \
       _Pragma("omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)")         \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                       \
-        for (int k = start[sl]; k < start[sl + 1]; ++k) p2g_point(sim, D, B, order[k]);     \
+        for (int k = start[sl]; k < start[sl + 1]; ++k) p2g_point(sim, D, B, node, order[k]); \
     }                                                                                       \
   }
 MPMC_KERNELS(P2G_KERNEL)
@@ -260,6 +299,14 @@ MPMC_KERNELS(P2G_KERNEL)
  * last step's box and built this step's slabs (mpmc_slabs_build). */
 int MPMC_ISA(mpmc_p2g)(mpmc_sim sim, double dt) {
   (void)dt;
-  MPMC_KERNEL_CALL(p2g_, sim, sim);
+#ifdef _OPENMP
+  const int nt = omp_get_max_threads();
+#else
+  const int nt = 1;
+#endif
+  double *priv = private_grids(sim, nt);
+  sim->grid.nprivate = priv ? nt : 0;
+  MPMC_KERNEL_CALL(p2g_, sim, sim, priv, nt);
+  if (priv) mpmc_grid_add_copies(&sim->grid, sim->grid.node, priv, MPMC_NREC, nt - 1);
   return MPMC_SUCCESS;
 }
