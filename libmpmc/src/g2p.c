@@ -120,6 +120,14 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
  * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
  * fused scatter is race-free, or, when P2G scattered into one grid per thread, in P2G's
  * chunks, each thread scattering into its own copy of fb. */
+/* g2p_point with F-bar's scatter into fbuf, in form fb (1: Algorithm 1's weights, 2: the
+ * stable form's) */
+MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS, int fb, double dt,
+                                   const g2p_ctx *c, double *restrict fbuf, int q) {
+  return fb == 2 ? g2p_point(sim, DIM, BASIS, 2, dt, c, fbuf, q)
+                 : g2p_point(sim, DIM, BASIS, 1, dt, c, fbuf, q);
+}
+
 #define G2P_KERNEL(D, B)                                                                     \
   static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {           \
     int first_bad = INT_MAX;                                                                 \
@@ -140,12 +148,9 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       for (int t = 0; t < nc; ++t) {                                                         \
         double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                  \
         const int k1_ = (int)((long long)sim->p.n * (t + 1) / nc);                           \
-        for (int k = (int)((long long)sim->p.n * t / nc); k < k1_; ++k) {                    \
-          const int q_ = order[k];                                                           \
-          const int ok_ = fb == 2 ? g2p_point(sim, D, B, 2, dt, c, f_, q_)                   \
-                                  : g2p_point(sim, D, B, 1, dt, c, f_, q_);                  \
-          if (!ok_ && q_ < first_bad) first_bad = q_;                                        \
-        }                                                                                    \
+        for (int k = (int)((long long)sim->p.n * t / nc); k < k1_; ++k)                      \
+          if (!g2pfb_point(sim, D, B, fb, dt, c, f_, order[k]) && order[k] < first_bad)      \
+            first_bad = order[k];                                                            \
       }                                                                                      \
       *bad = first_bad == INT_MAX ? -1 : first_bad;                                          \
       return;                                                                                \
@@ -153,12 +158,9 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int colour = 0; colour < 2; ++colour) {                                             \
       _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
-        for (int k = start[sl]; k < start[sl + 1]; ++k) {                                    \
-          const int q_ = order[k];                                                           \
-          const int ok_ = fb == 2 ? g2p_point(sim, D, B, 2, dt, c, fb0, q_)                  \
-                                  : g2p_point(sim, D, B, 1, dt, c, fb0, q_);                 \
-          if (!ok_ && q_ < first_bad) first_bad = q_;                                        \
-        }                                                                                    \
+        for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
+          if (!g2pfb_point(sim, D, B, fb, dt, c, fb0, order[k]) && order[k] < first_bad)     \
+            first_bad = order[k];                                                            \
     }                                                                                        \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
   }
