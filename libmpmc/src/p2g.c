@@ -152,6 +152,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   for (int t = 0; t < nc; ++t) {
     int *fill = cnt + (size_t)t * nmax;
     const int q0 = (int)((long long)n * t / nc), q1 = (int)((long long)n * (t + 1) / nc);
+    if (q0 >= q1) continue; /* more threads than points to share */
     int cur = plane[q0], pos = fill[cur];
     for (int q = q0; q < q1; ++q) {
       const int pl = plane[q];
