@@ -185,6 +185,12 @@ static void test_slab_order(void **state) {
       fail_msg("order[%d] = %d on one thread, %d on %d", k, sim->order[k], first[k], saved);
   free(first);
   free(seen);
+  /* the axis rule: z once the points span MPMC_SLAB_PLANES planes along it (the landslide:
+   * 275 cells long, 30 high), else the longest extent (y and x in 2D likewise) */
+  const int clo[3] = {0, 0, 0}, tall[3] = {274, 24, MPMC_SLAB_PLANES - 1}, flat[3] = {274, 24, MPMC_SLAB_PLANES - 2};
+  if (mpmc_slab_axis(3, clo, tall) != 2) fail_msg("slab axis %d for %d z planes, expected 2", mpmc_slab_axis(3, clo, tall), MPMC_SLAB_PLANES);
+  if (mpmc_slab_axis(3, clo, flat) != 0) fail_msg("slab axis %d for %d z planes, expected 0", mpmc_slab_axis(3, clo, flat), MPMC_SLAB_PLANES - 1);
+  if (mpmc_slab_axis(2, clo, tall) != 1) fail_msg("2D: slab axis %d for 25 y planes, expected 1", mpmc_slab_axis(2, clo, tall));
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
 }

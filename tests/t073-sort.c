@@ -179,8 +179,8 @@ static void compare(const result *a, const result *b, const char *what) {
     if (a->set[j] != b->set[j]) fail_msg("%s: set entry %d is id %d, unsorted %d", what, j, a->set[j], b->set[j]);
 }
 
-/* points out of cell order: the key runs over the slab axis (the longest extent of the
- * points' cells, ties to the outermost) first, then the other axes from the outermost in */
+/* points out of cell order: the key runs over the slab axis (mpmc_slab_axis's rule) first,
+ * then the other axes from the outermost in */
 static long out_of_order(mpmc_sim sim) {
   const mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
@@ -191,9 +191,10 @@ static long out_of_order(mpmc_sim sim) {
       const double c = floor((p->x[q * d + a] - g->origin[a]) * g->inv_h);
       clo[a] = fmin(clo[a], c), chi[a] = fmax(chi[a], c);
     }
-  int ax = d - 1;
-  for (int a = d - 2; a >= 0; --a)
-    if (chi[a] - clo[a] > chi[ax] - clo[ax]) ax = a;
+  int ax = d - 1; /* the outermost axis when it spans MPMC_SLAB_PLANES planes, else the longest */
+  if (chi[d - 1] - clo[d - 1] + 1 < MPMC_SLAB_PLANES)
+    for (int a = d - 2; a >= 0; --a)
+      if (chi[a] - clo[a] > chi[ax] - clo[ax]) ax = a;
   long bad = 0;
   double prev = -1;
   for (int q = 0; q < p->n; ++q) {

@@ -26,7 +26,7 @@
  * through the summation order at the nodes that two slabs share.
  * Both passes over the points run on all threads, each over a fixed chunk of them: the
  * first finds the box and counts the points per plane of the slab axis (the last step's
- * axis; counted again in the rare step where the box's longest extent changes axis), the
+ * axis; counted again in the rare step where mpmc_slab_axis picks another for the box), the
  * second places them.  Each point's plane is kept in between in dF, which is free from the
  * end of one step's material update until its G2P (sort.c uses it likewise).  The order
  * does not depend on the chunks, so neither on the thread count. */
@@ -111,7 +111,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     }
     const int best = mpmc_slab_axis(d, clo, chi);
     if (best == ax) break;
-    ax = best; /* the box's longest extent moved to another axis: count along that one */
+    ax = best; /* the box calls for another axis: count along that one */
   }
   for (int a = 0; a < 3; ++a) {
     const int lo = a < d ? clo[a] - 1 : 0, hi = a < d ? chi[a] + 3 : 1;

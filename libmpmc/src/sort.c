@@ -5,9 +5,10 @@
  * stencils hit the same cache lines of the grid, and the slab order reads the particle
  * arrays in runs instead of at random.  As a run goes on, points flow away from where they
  * were seeded and the store loses that order; mpmc_sim_sort_particles restores it by a
- * stable counting sort on the cell, with the slab axis (the longest extent of the points,
- * as p2g.c picks it) outermost and the others in the grid's memory order, so that a slab is
- * one contiguous run of points; within a cell the points go by the half of the cell they lie
+ * stable counting sort on the cell, with the slab axis (mpmc_slab_axis: z, or y in 2D, when
+ * the points span enough cell planes along it, else their longest extent; as p2g.c picks it)
+ * outermost and the others in the grid's memory order, so that a slab is one contiguous run
+ * of points and consecutive points mostly step along x, where node records are contiguous; within a cell the points go by the half of the cell they lie
  * in along each axis, the same order in every cell (the kernels' branches then repeat).
  *
  * Every per-point array moves with the points: the fields, the material ids, the friction
