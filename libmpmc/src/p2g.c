@@ -14,8 +14,8 @@
 /* Bucket the points into slabs of whole cell planes along one axis (a counting sort of
  * indices, by plane and within a plane by index; the particle arrays themselves are not
  * moved here: sort.c does that, every sort_interval steps when the caller asks for it), and
- * set the grid's active box to the nodes the points' stencils reach.  Visiting the points
- * of a slab in index order (particle arrays in order, grid at random when the points are
+ * set the grid's active box to the nodes the points' stencils reach.  Visiting a plane's
+ * points in index order (particle arrays in order, grid at random when the points are
  * shuffled) was faster than by cell (grid in order, particle arrays at random) on the 3D
  * column; sorted points are in both orders at once.
  * Slabs of one parity run in parallel: a point in cell c touches nodes c-1 .. c+2 at most
@@ -23,7 +23,8 @@
  * node.  The slab boundaries balance the points: about 2 x threads slabs or a multiple, so
  * each thread gets the same share of each colour (fixed-width slabs left one of two threads
  * idle for a third of P2G in the 3D column).  Results depend on the thread count only
- * through the summation order at the nodes that two slabs share.
+ * through the summation order at the nodes that two slabs share (at every node when the
+ * threads scatter into grids of their own, private_grids).
  * Both passes over the points run on all threads, each over a fixed chunk of them: the
  * first finds the box and counts the points per plane of the slab axis (the last step's
  * axis; counted again in the rare step where mpmc_slab_axis picks another for the box), the
