@@ -163,10 +163,9 @@ int main(int argc, char **argv) {
            bn[cases[c].basis], fb[cases[c].fbar], cases[c].j2 ? "hencky_j2" : "hencky", np, r1 / 1e6,
            r2 / 1e6, r2 / r1, last_bytes);
     if (phases) { /* the last run's (the 2-thread one when both ran) */
-      static const char *const ph[MPMC_PHASE_COUNT] = {"sort", "slabs", "p2g",    "grid",
-                                                       "g2p",  "fbar",  "stress", "checks"};
       printf("  phases (%% of the step):");
-      for (int k = 0; k < MPMC_PHASE_COUNT; ++k) printf(" %s %.1f", ph[k], 100 * last_phase[k]);
+      for (int k = 0; k < MPMC_PHASE_COUNT; ++k)
+        printf(" %s %.1f", mpmc_phase_name(k), 100 * last_phase[k]);
       printf("\n");
     }
     fflush(stdout);

@@ -74,6 +74,8 @@ program t111_fields_f
     'phase times >= 0, P2G''s > 0')
   call expect_close('sum of the phase times', st%wall_seconds, sum(st%phase_seconds), &
     1.0e-9_c_double*st%wall_seconds)
+  call check(mpmc_phase_name(MPMC_PHASE_G2P) == 'g2p', 'phase name of MPMC_PHASE_G2P: "'// &
+    mpmc_phase_name(MPMC_PHASE_G2P)//'"')
   call ok(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, v), 'restore velocity')
   call ok(mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, x), 'restore position')
   call check(.not. associated(x), 'restore nullifies the rank-2 pointer')

@@ -80,6 +80,9 @@ static void compare(mpmc_sim a, mpmc_sim b) {
   TCALL(mpmc_sim_get_stats(b, &sb));
   assert_int_equal(sa.steps, sb.steps);
   assert_int_equal(sa.particle_steps, sb.particle_steps);
+  assert_string_equal(mpmc_phase_name(MPMC_PHASE_SLABS), "slabs");
+  assert_string_equal(mpmc_phase_name(MPMC_PHASE_CHECKS), "checks");
+  assert_string_equal(mpmc_phase_name(MPMC_PHASE_COUNT), "unknown phase");
   /* the step's wall time is the sum of its phases' (the checkpoint carries both) */
   const mpmc_stats *st[2] = {&sa, &sb};
   for (int r = 0; r < 2; ++r) {

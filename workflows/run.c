@@ -600,11 +600,9 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
           st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);
   fprintf(f, "  \"return_maps\": %lld,\n  \"kinsol_fallbacks\": %lld,\n", (long long)st.return_maps,
           (long long)st.kinsol_fallbacks);
-  static const char *const phase_names[MPMC_PHASE_COUNT] = {"sort", "slabs", "p2g", "grid",
-                                                            "g2p",  "fbar",  "stress", "checks"};
   fputs("  \"phase_seconds\": {", f);
   for (int k = 0; k < MPMC_PHASE_COUNT; ++k)
-    fprintf(f, "%s\"%s\": %.6g", k ? ", " : "", phase_names[k], st.phase_seconds[k]);
+    fprintf(f, "%s\"%s\": %.6g", k ? ", " : "", mpmc_phase_name(k), st.phase_seconds[k]);
   fputs("},\n", f);
   fputs("  \"stages\": [", f);
   for (int i = 0; i < nstages_done; ++i) {

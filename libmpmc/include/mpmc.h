@@ -117,6 +117,9 @@ typedef enum {
   MPMC_PHASE_CHECKS = 7,  /* stability limit, rigid bodies' contact, run monitor         */
   MPMC_PHASE_COUNT = 8
 } mpmc_phase;
+/* The phase's name ("sort", "slabs", "p2g", "grid", "g2p", "fbar", "stress", "checks"), as
+ * summary.json keys it; "unknown phase" outside the list. */
+const char *mpmc_phase_name(int phase);
 
 /* Run statistics, accumulated since creation. */
 typedef struct {

@@ -93,14 +93,15 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       const mpmc_b4l sign = (mpmc_b4l)(-(one * 0.0)); /* -0.0: the sign bits */
       mpmc_b4d u = x + l, v = x - l;
       /* clamp to [-1, 1] exactly (outside the support both ends clamp alike and w = dw = 0) */
-      mpmc_b4l m = u > one;
-      u = (mpmc_b4d)((m & (mpmc_b4l)one) | (~m & (mpmc_b4l)u));
-      m = u < -one;
-      u = (mpmc_b4d)((m & (mpmc_b4l)(-one)) | (~m & (mpmc_b4l)u));
-      m = v > one;
-      v = (mpmc_b4d)((m & (mpmc_b4l)one) | (~m & (mpmc_b4l)v));
-      m = v < -one;
-      v = (mpmc_b4d)((m & (mpmc_b4l)(-one)) | (~m & (mpmc_b4l)v));
+#define CLAMP1_(y)                                                      \
+  do {                                                                  \
+    const mpmc_b4l hi_ = (y) > one, lo_ = (y) < -one;                   \
+    y = (mpmc_b4d)((hi_ & (mpmc_b4l)one) | (~hi_ & (mpmc_b4l)(y)));     \
+    y = (mpmc_b4d)((lo_ & (mpmc_b4l)(-one)) | (~lo_ & (mpmc_b4l)(y)));  \
+  } while (0)
+      CLAMP1_(u);
+      CLAMP1_(v);
+#undef CLAMP1_
       const mpmc_b4d nu = one - (mpmc_b4d)((mpmc_b4l)u & ~sign); /* N(u) = 1 - |u| */
       const mpmc_b4d nv = one - (mpmc_b4d)((mpmc_b4l)v & ~sign);
       const mpmc_b4d uv = u * v;

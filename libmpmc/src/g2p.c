@@ -116,10 +116,6 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   return ok;
 }
 
-/* Without F-bar the points run in index order, split evenly among the threads; with it by
- * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
- * fused scatter is race-free, or, when P2G scattered into one grid per thread, in P2G's
- * chunks, each thread scattering into its own copy of fb. */
 /* g2p_point with F-bar's scatter into fbuf, in form fb (1: Algorithm 1's weights, 2: the
  * stable form's) */
 MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS, int fb, double dt,
@@ -128,6 +124,10 @@ MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS,
                  : g2p_point(sim, DIM, BASIS, 1, dt, c, fbuf, q);
 }
 
+/* Without F-bar the points run in index order, split evenly among the threads; with it by
+ * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
+ * fused scatter is race-free, or, when P2G scattered into one grid per thread, in P2G's
+ * chunks, each thread scattering into its own copy of fb. */
 #define G2P_KERNEL(D, B)                                                                     \
   static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {           \
     int first_bad = INT_MAX;                                                                 \
@@ -147,8 +147,8 @@ MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS,
       _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) num_threads(nc)") \
       for (int t = 0; t < nc; ++t) {                                                         \
         double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                  \
-        const int k1_ = (int)((long long)sim->p.n * (t + 1) / nc);                           \
-        for (int k = (int)((long long)sim->p.n * t / nc); k < k1_; ++k)                      \
+        const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                               \
+        for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1_; ++k)                        \
           if (!g2pfb_point(sim, D, B, fb, dt, c, f_, order[k]) && order[k] < first_bad)      \
             first_bad = order[k];                                                            \
       }                                                                                      \

@@ -75,30 +75,29 @@ void mpmc_grid_clear(mpmc_grid *g, int with_fbar) {
   g->fb_done = 0;
 }
 
-/* Rows of the active box on all threads (a serial memset of the landslide's box, ~12 MB,
- * was half of the step's slab phase on two threads) */
-void mpmc_grid_clear_active(mpmc_grid *g) {
+/* Zero the active box's rows of node (when with_node) and of fb (when allocated), on all
+ * threads: a serial memset of the landslide's box, ~12 MB, was half of the step's slab
+ * phase on two threads. */
+static void clear_box(mpmc_grid *g, int with_node) {
   const long nrow = mpmc_grid_active_rows(g);
   const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
-  /* the F-bar sums whenever allocated (F-bar may have been on in an earlier step); every
-     form's supports lie in the active box */
-  double *fb = g->fb;
+  double *node = with_node ? g->node : NULL, *fb = g->fb;
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
     const size_t first = mpmc_grid_active_row(g, r);
-    memset(g->node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
+    if (node) memset(node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
     if (fb) memset(fb + first * 2, 0, len * 2 * sizeof(double));
   }
+}
+
+/* the F-bar sums too, whenever allocated (F-bar may have been on in an earlier step); every
+ * form's supports lie in the active box */
+void mpmc_grid_clear_active(mpmc_grid *g) {
+  clear_box(g, 1);
   g->fb_done = 0;
 }
 
-void mpmc_grid_clear_fb_active(mpmc_grid *g) {
-  const long nrow = mpmc_grid_active_rows(g);
-  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
-#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
-  for (long r = 0; r < nrow; ++r)
-    memset(g->fb + mpmc_grid_active_row(g, r) * 2, 0, len * 2 * sizeof(double));
-}
+void mpmc_grid_clear_fb_active(mpmc_grid *g) { clear_box(g, 0); }
 
 void mpmc_grid_free(mpmc_grid *g) {
   free(g->node);

@@ -267,14 +267,18 @@ struct mpmc_sim_s {
  * so two slabs of the same parity, one slab apart, share no node when the slab between them
  * is wider than 2 cells (slabs are widened beyond this to balance the points per thread). */
 #define MPMC_SLAB_W 3
+/* Chunk t of nc consecutive chunks of [0, n): the first index; chunk t ends where t + 1
+ * begins (the slab build, and P2G's and G2P's per-thread grids, split the points so) */
+static inline int mpmc_chunk_start(int n, int t, int nc) { return (int)((long long)n * t / nc); }
 /* The slab axis for points whose cells span [clo, chi] per axis: the outermost axis of the
  * grid's memory (z in 3D, y in 2D) when the points span MPMC_SLAB_PLANES cell planes along
  * it, else the longest extent, ties to the outermost.  p2g.c slabs along it and sort.c puts it
  * outermost in its key, so the innermost sort axis, along which consecutive points follow
  * one another, is x, the axis along which node records are contiguous whenever x is not the
  * slab axis: with x as slab axis (the landslide's, 55 m long) consecutive points stepped
- * along y, a row of records (18 kB) apart, and G2P took 9 % longer.  24 planes make eight slabs of three planes or
- * more for two threads, four per colour (p2g.c balances the points among them). */
+ * along y, a row of records (18 kB) apart, and G2P took a quarter longer.  24 planes make
+ * eight slabs of three planes or more for two threads, four per colour (p2g.c balances the
+ * points among them). */
 #define MPMC_SLAB_PLANES 24
 static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
   if (chi[dim - 1] - clo[dim - 1] + 1 >= MPMC_SLAB_PLANES) return dim - 1;

@@ -77,7 +77,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
       int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
       int *ct = cnt + (size_t)t * nmax;
       for (int k = 0; k < nmax; ++k) ct[k] = 0;
-      const int q0 = (int)((long long)n * t / nc), q1 = (int)((long long)n * (t + 1) / nc);
+      const int q0 = mpmc_chunk_start(n, t, nc), q1 = mpmc_chunk_start(n, t + 1, nc);
       int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
       for (int q = q0; q < q1; ++q) {
         const double *x = p->x + (size_t)q * d;
@@ -152,7 +152,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
 #pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
   for (int t = 0; t < nc; ++t) {
     int *fill = cnt + (size_t)t * nmax;
-    const int q0 = (int)((long long)n * t / nc), q1 = (int)((long long)n * (t + 1) / nc);
+    const int q0 = mpmc_chunk_start(n, t, nc), q1 = mpmc_chunk_start(n, t + 1, nc);
     if (q0 >= q1) continue; /* more threads than points to share */
     int cur = plane[q0], pos = fill[cur];
     for (int q = q0; q < q1; ++q) {
@@ -282,10 +282,10 @@ static double *private_grids(mpmc_sim sim, int nt) {
       const size_t per = sim->grid.nn * MPMC_NREC;                                          \
       _Pragma("omp parallel for schedule(static, 1) num_threads(nc)")                       \
       for (int t = 0; t < nc; ++t) {                                                        \
-        const int k0 = (int)((long long)sim->p.n * t / nc);                                 \
-        const int k1 = (int)((long long)sim->p.n * (t + 1) / nc);                           \
+        const int k1 = mpmc_chunk_start(sim->p.n, t + 1, nc);                               \
         double *rec = t ? priv + per * (size_t)(t - 1) : node;                              \
-        for (int k = k0; k < k1; ++k) p2g_point(sim, D, B, rec, order[k]);                  \
+        for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1; ++k)                        \
+          p2g_point(sim, D, B, rec, order[k]);                                              \
       }                                                                                     \
       return;                                                                               \
     }                                                                                       \

@@ -8,8 +8,9 @@
  * stable counting sort on the cell, with the slab axis (mpmc_slab_axis: z, or y in 2D, when
  * the points span enough cell planes along it, else their longest extent; as p2g.c picks it)
  * outermost and the others in the grid's memory order, so that a slab is one contiguous run
- * of points and consecutive points mostly step along x, where node records are contiguous; within a cell the points go by the half of the cell they lie
- * in along each axis, the same order in every cell (the kernels' branches then repeat).
+ * of points and consecutive points mostly step along x, where node records are contiguous;
+ * within a cell the points go by the half of the cell they lie in along each axis, the same
+ * order in every cell (the kernels' branches then repeat).
  *
  * Every per-point array moves with the points: the fields, the material ids, the friction
  * anchors of the rigid bodies, the user materials' state, and the particle sets' indices are

@@ -31,6 +31,15 @@ static const kernel_set avx2 = {mpmc_slabs_build_avx2, mpmc_p2g_avx2, mpmc_grid_
 #define KERNELS(sim) (&baseline)
 #endif
 
+/**
+ * @brief The name of a step phase (mpmc_phase), a static string.
+ */
+const char *mpmc_phase_name(int phase) {
+  static const char *const names[MPMC_PHASE_COUNT] = {"sort", "slabs", "p2g",    "grid",
+                                                      "g2p",  "fbar",  "stress", "checks"};
+  return phase >= 0 && phase < MPMC_PHASE_COUNT ? names[phase] : "unknown phase";
+}
+
 /* The wall time since *t goes to phase ph; *t becomes now. */
 static void lap(mpmc_sim sim, int ph, double *t) {
   const double t1 = now();
