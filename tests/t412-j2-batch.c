@@ -2,9 +2,12 @@
  * return map of each point (mpmc_j2_return_map): 2D and 3D, a point count that leaves a
  * partial last block, two J2 materials and a Hencky one interleaved (masked lanes), elastic
  * points of strains from 1e-9 to past the series' range (the eigen fallback), plastic
- * points with and without softening history; b_e, eps_p and the stress agree to 1e-12, the
- * counts of plastic corrections match, both instruction sets give the same bits, and a point
- * with a non-finite dF fails the update with its own index in the message. */
+ * points with and without softening history, and a steeply softening material whose
+ * returns the auto solver hands to KINSOL; with the newton and the auto solver (whose
+ * plastic points the blocks return four at a time, stress_j2.c's plastic4) b_e, eps_p and the
+ * stress agree to 1e-12, the counts of plastic corrections and KINSOL fallbacks match, both
+ * instruction sets give the same bits, and a point with a non-finite dF fails the update
+ * with its own index in the message. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -24,7 +27,7 @@
 
 typedef struct {
   double be[6 * NP], eps_p[NP], stress[6 * NP];
-  int64_t plastic;
+  int64_t plastic, fallbacks;
 } state;
 
 static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
@@ -35,10 +38,16 @@ static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e7, 0.3, 2000, 3e4, 5e3, 8, &mats[0]));
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 5e7, 0.49, 1800, 2e5, 2e5, 0, &mats[1]));
   TCALL(mpmc_sim_add_material_hencky(sim, 1e7, 0.3, 2000, &mats[2]));
+  /* eta (kappa_p - kappa_r) = 3e6 > 3G = 1.15e6: g' > 0 near the bracket's lower end */
+  TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e6, 0.3, 2000, 1.2e4, 2e3, 300, &mats[3]));
   for (int q = 0; q < NP; ++q) {
     const double x[3] = {0.3 + 0.004 * q, 0.5, 0.5}, v = 1e-4;
-    /* J2 A mostly, J2 B every third point, Hencky every seventh: blocks mix materials */
-    const int m = q % 7 == 3 ? mats[2] : q % 3 == 1 ? mats[1] : mats[0];
+    /* J2 A mostly, J2 B every third point, Hencky every seventh, the steep J2 every fifth:
+     * blocks mix materials */
+    const int m = q % 7 == 3   ? mats[2]
+                  : q % 5 == 4 ? mats[3]
+                  : q % 3 == 1 ? mats[1]
+                               : mats[0];
     TCALL(mpmc_sim_add_particles(sim, 1, x, &v, m, NULL));
   }
   TCALL(mpmc_sim_prepare(sim));
@@ -80,13 +89,16 @@ static void save(const mpmc_sim sim, state *s) {
   memcpy(s->eps_p, sim->p.eps_p, sizeof s->eps_p);
   memcpy(s->stress, sim->p.stress, sizeof s->stress);
   s->plastic = sim->stats.return_maps;
+  s->fallbacks = sim->stats.kinsol_fallbacks;
 }
 
-static void run_dim(int dim) {
+static const int j2_mats[3] = {0, 1, 3}; /* the indices in mats[] of the J2 materials */
+
+static void run_dim(int dim, int solver) {
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
-  int mats[3];
+  int mats[4];
   mpmc_sim sim = make(ctx, dim, mats);
   mpmc_particles *p = &sim->p;
   fill(sim);
@@ -96,7 +108,9 @@ static void run_dim(int dim) {
   memcpy(dF0, p->dF, sizeof(double) * NP * dim * dim);
   /* the expected state, point by point by the scalar return map */
   state want = {0};
-  int plastic = 0, series_out = 0;
+  int plastic = 0, fallbacks = 0, series_out = 0;
+  mpmc_rm_ws *ws;
+  TCALL(mpmc_rm_ws_create(&ws));
   for (int q = 0; q < NP; ++q) {
     memcpy(want.be + 6 * q, be0 + 6 * q, sizeof(double) * 6);
     want.eps_p[q] = ep0[q];
@@ -106,18 +120,21 @@ static void run_dim(int dim) {
     double F[3][3], tau[6], J;
     mpmc_embed(dim, dF0 + q * dim * dim, F);
     mpmc_j2_info info = {0};
-    TCALL(mpmc_j2_return_map(NULL, MPMC_SOLVER_NEWTON, &par, F, want.be + 6 * q, want.eps_p + q, tau,
-                             &J, &info));
+    TCALL(mpmc_j2_return_map(ws, solver, &par, F, want.be + 6 * q, want.eps_p + q, tau, &J, &info));
     for (int k = 0; k < 6; ++k) want.stress[6 * q + k] = tau[k] / J;
     plastic += info.plastic;
+    fallbacks += info.fallback;
     double b[6], eps[6];
     memcpy(b, be0 + 6 * q, sizeof b);
     mpmc_push_forward(F, b);
     series_out += mpmc_sym3_log_series(b, eps);
   }
-  if (plastic < 10 || NP - plastic < 30 || series_out < 3)
-    fail_msg("dim %d: weak mix: %d plastic, %d outside the series", dim, plastic, series_out);
-  TCALL(mpmc_sim_set_solver(sim, MPMC_SOLVER_NEWTON));
+  mpmc_rm_ws_destroy(&ws);
+  if (plastic < 10 || NP - plastic < 30 || series_out < 3 ||
+      (solver == MPMC_SOLVER_AUTO && (fallbacks < 2 || plastic - fallbacks < 10)))
+    fail_msg("dim %d: weak mix: %d plastic, %d by KINSOL, %d outside the series", dim, plastic,
+             fallbacks, series_out);
+  TCALL(mpmc_sim_set_solver(sim, solver));
   state got[2];
   const int sets[2] = {MPMC_KERNELS_BASELINE, MPMC_KERNELS_AVX2};
   int nsets = 0;
@@ -130,12 +147,18 @@ static void run_dim(int dim) {
     memcpy(p->eps_p, ep0, sizeof ep0);
     memcpy(p->dF, dF0, sizeof(double) * NP * dim * dim);
     for (int k = 0; k < 6 * NP; ++k) p->stress[k] = 0.0;
-    const int64_t before = sim->stats.return_maps;
-    for (int m = 0; m < 2; ++m) TCALL(sim->mats[mats[m]].ops->stress_update(sim, &sim->mats[mats[m]], mats[m], 1e-3));
+    const int64_t before = sim->stats.return_maps, fb_before = sim->stats.kinsol_fallbacks;
+    for (int k = 0; k < 3; ++k) {
+      const int m = mats[j2_mats[k]];
+      TCALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, 1e-3));
+    }
     save(sim, &got[nsets]);
     got[nsets].plastic -= before;
+    got[nsets].fallbacks -= fb_before;
     const state *g = &got[nsets++];
-    if (g->plastic != plastic) fail_msg("dim %d, set %d: %lld plastic corrections, expected %d", dim, sets[s], (long long)g->plastic, plastic);
+    if (g->plastic != plastic || g->fallbacks != fallbacks)
+      fail_msg("dim %d, solver %d, set %d: %lld plastic corrections, %lld by KINSOL, expected %d, %d",
+               dim, solver, sets[s], (long long)g->plastic, (long long)g->fallbacks, plastic, fallbacks);
     for (int q = 0; q < NP; ++q) {
       double smax = 0;
       for (int k = 0; k < 6; ++k) smax = fmax(smax, fabs(want.stress[6 * q + k]));
@@ -170,8 +193,11 @@ static void run_dim(int dim) {
 
 static void test_batch_equals_scalar(void **state) {
   (void)state;
-  run_dim(3);
-  run_dim(2);
+  const int solvers[2] = {MPMC_SOLVER_NEWTON, MPMC_SOLVER_AUTO};
+  for (int k = 0; k < 2; ++k) {
+    run_dim(3, solvers[k]);
+    run_dim(2, solvers[k]);
+  }
 }
 
 int main(void) {

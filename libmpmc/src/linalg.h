@@ -187,6 +187,18 @@ static inline void mpmc_sym3_log_eig(const double *b, double *eps) {
   mpmc_sym3_compose(lam, Q, eps);
 }
 
+/* exp's series tables: the largest |M|^2 for n terms, and the coefficients 1/k! (also
+ * stress_j2.c's, which sums the series of a plastic return four points at a time) */
+static const double mpmc_exp_rho2_max[17] = {
+    0.0,        1.110e-16,  4.804e-11,  3.649e-08,  2.1326e-06, 3.4057e-05,
+    2.5668e-04, 1.2021e-03, 4.0814e-03, 1.1030e-02, 2.5199e-02, 5.0682e-02,
+    9.2330e-02, 1.5550e-01, 2.4586e-01, 3.6911e-01, 5.3089e-01};
+static const double mpmc_exp_c[17] = {
+    1.0,           1.0,           1.0 / 2.0,       1.0 / 6.0,        1.0 / 24.0,
+    1.0 / 120.0,   1.0 / 720.0,   1.0 / 5040.0,    1.0 / 40320.0,    1.0 / 362880.0,
+    1.0 / 3628800.0, 1.0 / 39916800.0, 1.0 / 479001600.0, 1.0 / 6227020800.0,
+    1.0 / 87178291200.0, 1.0 / 1307674368000.0, 1.0 / 20922789888000.0};
+
 /* E = exp(M) of a symmetric M (Voigt) of small norm by its Taylor series in Horner form
  * (the returned b_e = exp(2 eps) of a plastic point on the fast path).  With rho = |M|_F the
  * tail after M^n / n! is below rho^(n+1) / (n+1)! e^rho, and E's smallest eigenvalue is
@@ -194,27 +206,7 @@ static inline void mpmc_sym3_log_eig(const double *b, double *eps) {
  * that makes this <= 2^-54 (the table holds the largest rho^2 for each n).
  * Returns 0, or 1 when |M|_F > 0.728 or M is not finite. */
 static inline int mpmc_sym3_exp_series(const double *M, double *E) {
-  static const double rho2_max[17] = {
-      0.0,        1.110e-16,  4.804e-11,  3.649e-08,  2.1326e-06, 3.4057e-05,
-      2.5668e-04, 1.2021e-03, 4.0814e-03, 1.1030e-02, 2.5199e-02, 5.0682e-02,
-      9.2330e-02, 1.5550e-01, 2.4586e-01, 3.6911e-01, 5.3089e-01};
-  static const double c[17] = {1.0,
-                               1.0,
-                               1.0 / 2.0,
-                               1.0 / 6.0,
-                               1.0 / 24.0,
-                               1.0 / 120.0,
-                               1.0 / 720.0,
-                               1.0 / 5040.0,
-                               1.0 / 40320.0,
-                               1.0 / 362880.0,
-                               1.0 / 3628800.0,
-                               1.0 / 39916800.0,
-                               1.0 / 479001600.0,
-                               1.0 / 6227020800.0,
-                               1.0 / 87178291200.0,
-                               1.0 / 1307674368000.0,
-                               1.0 / 20922789888000.0};
+  const double *rho2_max = mpmc_exp_rho2_max, *c = mpmc_exp_c;
   const double r2 = mpmc_sym3_norm2(M);
   if (!(r2 <= rho2_max[16])) return 1;
   int n = 1;

@@ -19,8 +19,6 @@
 
 #include "return_map.h"
 
-#define RM_MAX_ITERS 80
-
 /* The scalar problem handed to KINSOL through its user data. */
 typedef struct {
   const mpmc_j2_param *m;
@@ -55,9 +53,7 @@ static inline double rm_r(const mpmc_j2_param *m, double qtr, double ep0, double
 }
 
 /* Converged when |r| is below 1e-12 of the residual strength (or round-off of kappa). */
-static inline double rm_tol(const mpmc_j2_param *m, double kappa0) {
-  return 1e-12 * m->kappa_r + 16.0 * DBL_EPSILON * kappa0;
-}
+static inline double rm_tol(const mpmc_j2_param *m, double kappa0) { return mpmc_rm_tol_k(m, kappa0); }
 double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p) {
   return rm_tol(m, mpmc_j2_kappa(m, eps_p));
 }
@@ -144,7 +140,7 @@ static int kinsol_init(mpmc_rm_ws *ws) {
          /* a fresh Jacobian every iteration (TOOLCHAIN.md: the default reuse of 10 makes a
             scalar Newton fail) */
          KINSetMaxSetupCalls(ws->kmem, 1) == KIN_SUCCESS &&
-         KINSetNumMaxIters(ws->kmem, RM_MAX_ITERS) == KIN_SUCCESS &&
+         KINSetNumMaxIters(ws->kmem, MPMC_RM_MAX_ITERS) == KIN_SUCCESS &&
          KINSetConstraints(ws->kmem, ws->constraints) == KIN_SUCCESS &&
          /* fscale = 1/tol below, so fnormtol = 1 means |g| <= tol */
          KINSetFuncNormTol(ws->kmem, 1.0) == KIN_SUCCESS &&
@@ -186,12 +182,10 @@ static int solve_kinsol(mpmc_rm_ws *ws, const mpmc_j2_param *m, double qtr, doub
 }
 
 /* exp(-x) for the small x of Newton's iterates (x = eta dgamma: a step's plastic increment
- * times the softening rate, mostly < 1e-2): Horner to x^6 / 6!, the tail below 2e-18 of the
- * value; libm's exp beyond. */
+ * times the softening rate, mostly < 1e-2): return_map.h's polynomial, libm's exp beyond. */
 static inline double exp_neg_small(double x) {
-  if (!(fabs(x) <= 1e-2)) return exp(-x);
-  return 1.0 - x * (1.0 - x * (1.0 / 2.0) * (1.0 - x * (1.0 / 3.0) * (1.0 - x * (1.0 / 4.0) *
-                                                   (1.0 - x * (1.0 / 5.0) * (1.0 - x * (1.0 / 6.0))))));
+  if (!(fabs(x) <= MPMC_RM_EXP_SMALL)) return exp(-x);
+  return MPMC_RM_EXP_NEG_POLY(x);
 }
 
 /* rm_r with kappa(eps_p) - kappa_r = a = (kappa_p - kappa_r) exp(-eta eps_p) known (the
@@ -212,7 +206,7 @@ static int solve_newton(const mpmc_j2_param *m, double qtr, double k0, double to
   double yi = *hi, rprev = INFINITY;
   const double a = k0 - m->kappa_r, c = m->eta / (3.0 * m->G);
   *res = NAN; /* |r(y)| when the returned y is an evaluated iterate, else NaN */
-  for (int it = 0; it < RM_MAX_ITERS; ++it) {
+  for (int it = 0; it < MPMC_RM_MAX_ITERS; ++it) {
     double dr;
     const double r = rm_r_k(m, a, c, qtr, yi, &dr);
     if (fabs(r) <= tol) {

@@ -13,6 +13,7 @@
 #ifndef MPMC_RETURN_MAP_H
 #define MPMC_RETURN_MAP_H
 
+#include <float.h>
 #include <math.h>
 
 #include "mpmc_impl.h"
@@ -57,6 +58,22 @@ static inline double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p) {
   return m->kappa_r + (m->kappa_p - m->kappa_r) * (x == 0.0 ? 1.0 : exp(-x));
 }
 double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p);
+/* The pieces of the auto solver's Newton iteration (return_map.c, solve_newton) that
+ * stress_j2.c runs four points at a time, lane by lane the same operations: the iteration
+ * limit, the tolerance |r| <= tol of a solve from kappa0 = kappa(eps_p), and exp(-x) for the
+ * small x = eta dgamma of its iterates (|x| <= 1e-2; libm's exp beyond), Horner to x^6 / 6!,
+ * the tail below 2e-18 of the value, written for doubles and vectors alike. */
+#define MPMC_RM_MAX_ITERS 80
+#define MPMC_RM_EXP_SMALL 1e-2
+#define MPMC_RM_EXP_NEG_POLY(x)                                                         \
+  (1.0 - (x) * (1.0 - (x) * (1.0 / 2.0) *                                               \
+                          (1.0 - (x) * (1.0 / 3.0) *                                    \
+                                     (1.0 - (x) * (1.0 / 4.0) *                         \
+                                                (1.0 - (x) * (1.0 / 5.0) *              \
+                                                           (1.0 - (x) * (1.0 / 6.0)))))))
+static inline double mpmc_rm_tol_k(const mpmc_j2_param *m, double kappa0) {
+  return 1e-12 * m->kappa_r + 16.0 * DBL_EPSILON * kappa0;
+}
 int mpmc_rm_solve(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q_trial,
                   double eps_p, double *dgamma, double *q_new, mpmc_j2_info *info);
 /* the same with kappa0 = mpmc_j2_kappa(m, eps_p) already known (saves its exp) */

@@ -84,6 +84,91 @@ static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) 
   sym_mul4(z, p, eps);
 }
 
+/* The plastic lanes of a block (pl[l] = 1) returned together, for the auto solver:
+ * return_map.c's Newton iteration (solve_newton, strict) lane by lane in vectors -- the
+ * same operations in the same order, the branches taken per lane, so each lane gets the
+ * scalar solve's bits -- then mpmc_j2_plastic's b_e = b exp(2 (f - 1) e), the series at the
+ * degree the largest lane needs.  Inputs: the trial b, its deviatoric strain e and trace tr,
+ * qtr > k0 = kappa(eps_p).  Outputs for each lane it returns: dg, be, the scaled deviator es.
+ * A lane the iteration calls stiff (KINSOL's case), whose result fails the solve's checks or
+ * ended on a round-off step (its residual needs libm's exp), or whose correction is beyond
+ * the series, gets pl[l] = 0: mpmc_j2_plastic repeats it alone and reports or falls back. */
+static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, v4 qtr, v4 k0,
+                            int *pl, v4 *dg, v4 *be, v4 *es) {
+  const double kr = m->kappa_r, c = m->eta / (3.0 * m->G);
+  const v4 a = k0 - kr;
+  v4 lo = k0 * 0.0 + kr, hi = k0, y, rprev = k0 * 0.0 + INFINITY, tol;
+  int run[4], nrun = 0;
+  for (int l = 0; l < 4; ++l) {
+    tol[l] = mpmc_rm_tol_k(m, k0[l]);
+    if (hi[l] < lo[l]) hi[l] = lo[l];
+    run[l] = pl[l];
+    nrun += run[l];
+  }
+  y = hi;
+  for (int it = 0; it < MPMC_RM_MAX_ITERS && nrun; ++it) {
+    const v4 x = c * (qtr - y);
+    v4 ex = MPMC_RM_EXP_NEG_POLY(x);
+    for (int l = 0; l < 4; ++l)
+      if (run[l] && !(fabs(x[l]) <= MPMC_RM_EXP_SMALL)) ex[l] = exp(-x[l]);
+    const v4 ee = a * ex;
+    const v4 dr = 1.0 - c * ee;
+    const v4 r = y - (kr + ee);
+    const v4 yn = y - r / dr;
+    for (int l = 0; l < 4; ++l) {
+      if (!run[l]) continue;
+      if (fabs(r[l]) <= tol[l]) { /* converged at an evaluated iterate */
+        run[l] = 0, --nrun;
+        continue;
+      }
+      if (r[l] < 0)
+        lo[l] = y[l];
+      else
+        hi[l] = y[l];
+      double ynl = yn[l];
+      const double slack = 8.0 * DBL_EPSILON * hi[l];
+      if (ynl > hi[l] && ynl <= hi[l] + slack) ynl = hi[l];
+      if (ynl < lo[l] && ynl >= lo[l] - slack) ynl = lo[l];
+      if (dr[l] <= 0.0 || (it >= 3 && fabs(r[l]) > 0.5 * fabs(rprev[l])) ||
+          !(ynl >= lo[l] && ynl <= hi[l]) || fabs(ynl - y[l]) <= 2.0 * DBL_EPSILON * fabs(ynl)) {
+        pl[l] = run[l] = 0, --nrun; /* stiff, or a round-off stop: the scalar path */
+        continue;
+      }
+      rprev[l] = r[l];
+      y[l] = ynl;
+    }
+  }
+  int n = 1, any = 0;
+  v4 en[6], r2;
+  *dg = (qtr - y) / (3.0 * m->G);
+  const v4 f = y / qtr, s2 = 2.0 * (f - 1.0);
+  for (int k = 0; k < 6; ++k) en[k] = s2 * e[k];
+  norm2_4(en, &r2);
+  for (int l = 0; l < 4; ++l) {
+    if (run[l]) pl[l] = 0; /* the iteration limit: the scalar path */
+    if (!pl[l]) continue;
+    if (!((*dg)[l] >= 0.0) || !isfinite((*dg)[l]) || !(y[l] > 0.0) ||
+        !(r2[l] <= mpmc_exp_rho2_max[16])) {
+      pl[l] = 0;
+      continue;
+    }
+    while (r2[l] > mpmc_exp_rho2_max[n]) ++n;
+    any = 1;
+  }
+  if (!any) return;
+  /* exp(en) as mpmc_sym3_exp_series, then b_e = b exp(en) */
+  const double *cf = mpmc_exp_c;
+  v4 p[6];
+  for (int k = 0; k < 6; ++k) p[k] = cf[n] * en[k];
+  for (int k = 0; k < 3; ++k) p[k] += cf[n - 1];
+  for (int j = n - 2; j >= 0; --j) {
+    sym_mul4(en, p, p);
+    for (int k = 0; k < 3; ++k) p[k] += cf[j];
+  }
+  sym_mul4(bt, p, be);
+  for (int k = 0; k < 6; ++k) es[k] = e[k] * f;
+}
+
 /**
  * Update the stress of every point of material id (F-bar scaled dF in p->dF): elastic
  * points in blocks of four, the others by the scalar return map.  *nret and *nfb count the
@@ -155,23 +240,62 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
       /* J = sqrt(det b) = exp(tr eps), without the exp */
       const v4 detb = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
                       bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
+      /* elastic lanes finish here; with the auto solver the plastic ones go on together
+       * (plastic4), the rest and any plastic4 hands back one by one (scalar) */
+      int pl[4] = {0, 0, 0, 0}, npl = 0, vec[4] = {0, 0, 0, 0}, scalar[4] = {0, 0, 0, 0};
+      v4 k0v, qtrv;
       for (int l = 0; l < 4; ++l) {
+        k0v[l] = qtrv[l] = 1.0;
         if (!act[l]) continue;
         const int q = q0 + l;
-        double *ep = p->eps_p + q;
-        const double k0 = mpmc_j2_kappa(&par, *ep);
+        const double k0 = mpmc_j2_kappa(&par, p->eps_p[q]);
         const double qtr = sqrt(q2[l]) * G2;
+        double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
+        if (!fail[l] && isfinite(qtr) && detb[l] > 0.0 && qtr <= k0) {
+          /* elastic: b_e = trial b */
+          const double inv_J = 1.0 / sqrt(detb[l]);
+          for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
+          for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
+          continue;
+        }
+        k0v[l] = k0, qtrv[l] = qtr;
+        pl[l] = solver == MPMC_SOLVER_AUTO && !fail[l] && isfinite(qtr) && detb[l] > 0.0;
+        npl += vec[l] = pl[l];
+        scalar[l] = !pl[l];
+      }
+      if (npl) {
+        v4 dg, bn[6], es[6];
+        plastic4(&par, bt, e, qtrv, k0v, pl, &dg, bn, es);
+        for (int l = 0; l < 4; ++l) {
+          if (!vec[l]) continue;
+          if (!pl[l]) { /* handed back */
+            scalar[l] = 1;
+            continue;
+          }
+          const int q = q0 + l;
+          double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
+          for (int k = 0; k < 6; ++k) be[k] = bn[k][l];
+          p->eps_p[q] += dg[l];
+          /* tau as mpmc_j2_plastic's (series_tau), sigma = tau / J, J = sqrt(det b) */
+          const double inv_J = 1.0 / sqrt(detb[l]);
+          for (int k = 0; k < 6; ++k) {
+            double t = 2.0 * par.G * es[k][l];
+            if (k < 3) t += K * tr[l];
+            sg[k] = t * inv_J;
+          }
+          ++nret;
+        }
+      }
+      for (int l = 0; l < 4; ++l) {
+        if (!act[l] || !scalar[l]) continue;
+        const int q = q0 + l;
+        double *ep = p->eps_p + q;
+        const double k0 = k0v[l], qtr = qtrv[l];
         double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
         double tau[6], J;
         mpmc_j2_info info = {0};
         int err;
         if (!fail[l] && isfinite(qtr) && detb[l] > 0.0) {
-          if (qtr <= k0) { /* elastic: b_e = trial b */
-            const double inv_J = 1.0 / sqrt(detb[l]);
-            for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
-            for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
-            continue;
-          }
           /* plastic: the scalar solve and b_e from this trial state */
           double bl[6], el[6];
           for (int k = 0; k < 6; ++k) bl[k] = bt[k][l], el[k] = e[k][l];
