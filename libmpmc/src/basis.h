@@ -12,68 +12,80 @@
 #define MPMC_ALWAYS_INLINE static inline __attribute__((always_inline))
 #define MPMC_MAX_STENCIL 4
 
-/* floor(s) as an int for |s| < 2^31: truncation corrected below zero.  libm's floor needs
- * SSE4.1 to be inlined (not in the x86-64 baseline); this is three instructions. */
-MPMC_ALWAYS_INLINE int mpmc_ifloor(double s) {
-  const int i = (int)s;
-  return i - (s < (double)i);
-}
-
 /* nodes per axis in a point's support */
 MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
   return basis == MPMC_BASIS_LINEAR ? 2 : basis == MPMC_BASIS_BSPLINE3 ? 4 : 3;
 }
 
-/* uGIMP, branch-free: the weight of a node at cell-unit distance x from a point of
- * half-length l (cell units, 0 < l <= 1/2) is the hat N(y) = max(0, 1 - |y|) averaged over
- * the point, w = (1/2l) int_{x-l}^{x+l} N.  With u, v = x + l, x - l clamped to [-1, 1] (N is 0
- * beyond) the integrand is linear on [v, u] but for the kink at 0, so
- *   w = [(u - v) (N(u) + N(v)) / 2 + max(0, -u v)] / (2l),   w' = (N(u) - N(v)) / (2l)
- * (trapezoid plus the kink's share).  In this form a weight near the support's ends keeps
- * its relative accuracy (u - v and 1 - |u| are exact there), which matters: a node reached
- * only by such a tail divides a force ~ w' by a mass ~ w, and the antiderivative's difference
- * H(u) - H(v), whose absolute rounding error is 1e-17, inverted a point of the 2D Cook membrane.
- * The same values as formulas.md's four pieces (t201 compares them), without the branches
- * whose outcome changes from point to point.  Written over MPMC_MAX_STENCIL lanes (the fourth
- * node, at x <= -3/2, gets exactly 0, as do nodes outside the support) so that the loop
- * becomes whole vectors. */
+/* The weights of one point along all axes at once: lane a of each vector is axis a (x, y,
+ * z, and an unused fourth lane), and every basis is the same arithmetic on every lane, so one
+ * evaluation in vectors of four doubles (one AVX2 register, two SSE2 ones) serves the three
+ * axes.  s = (x_p - origin)/h per lane; l = uGIMP half-length / h (all axes).  Writes the
+ * first stencil node per lane into base, and w[k], dw[k] (d/dx_p, per metre) of the k-th
+ * node of each axis's stencil, k < MPMC_MAX_STENCIL (0 beyond the stencil).
+ *
+ * uGIMP (0 < l <= 1/2): the hat N(x) = max(0, 1 - |x|) averaged over the point,
+ * w = (1/2l) int_{x-l}^{x+l} N, with y the point's offset from the middle node of its three
+ * (y in [-1/2, 1/2)) and c = y clamped to [-l, l]:
+ *   w0 = (l - c)^2 / 4l + max(0, -l - y),   w2 = (l + c)^2 / 4l + max(0, y - l),
+ *   w1 = 1 - (c^2 + l^2) / 2l - |y - c|,    w' = (c - l, -2c, c + l) / 2l
+ * which are formulas.md's pieces in each of the three ranges of y (the point's support
+ * overlapping the middle node's kink, or not, on either side), without branches.  A tail
+ * weight near the support's end keeps its relative accuracy (l - c and l + c are exact
+ * there), which matters: a node reached only by such a tail divides a force ~ w' by a mass
+ * ~ w; a difference of the hat's antiderivative, whose absolute rounding error is 1e-17,
+ * inverted a point of the 2D Cook membrane (t201 checks the tails).  Nodes outside the
+ * support get exactly 0. */
 typedef double mpmc_b4d __attribute__((vector_size(4 * sizeof(double))));
 typedef long long mpmc_b4l __attribute__((vector_size(4 * sizeof(long long))));
+typedef int mpmc_b4i __attribute__((vector_size(4 * sizeof(int))));
 
-/* Weights w[k] and gradients dw[k] (d/dx_p, per metre) of nodes base..base+S-1 along one
- * axis.  s = (x_p - origin)/h; l = uGIMP half-length / h. */
-MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_h, int *base,
-                                      double *w, double *dw) {
+/* floor per lane as doubles (|s| < 2^31), its int in *bi: truncation corrected below zero */
+/* (vectors through pointers: by value they would change the baseline build's ABI) */
+MPMC_ALWAYS_INLINE void mpmc_floor4(const mpmc_b4d *s, mpmc_b4i *bi, mpmc_b4d *fl) {
+  const mpmc_b4i i = __builtin_convertvector(*s, mpmc_b4i);
+  const mpmc_b4d d = __builtin_convertvector(i, mpmc_b4d);
+  const mpmc_b4l below = *s < d;
+  *bi = i + __builtin_convertvector(below, mpmc_b4i);
+  *fl = d - (mpmc_b4d)(below & (mpmc_b4l)(mpmc_b4d){1.0, 1.0, 1.0, 1.0});
+}
+
+MPMC_ALWAYS_INLINE void mpmc_basis_axes(int basis, const mpmc_b4d *sp, double l, double inv_h,
+                                        mpmc_b4i *base, mpmc_b4d *w, mpmc_b4d *dw) {
+  const mpmc_b4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0}, s = *sp;
+  mpmc_b4d fl, sh;
   switch (basis) {
     case MPMC_BASIS_LINEAR: {
-      const int b = mpmc_ifloor(s);
-      const double f = s - b;
-      *base = b;
-      w[0] = 1.0 - f;
+      mpmc_floor4(&s, base, &fl);
+      const mpmc_b4d f = s - fl;
+      w[0] = one - f;
       w[1] = f;
-      dw[0] = -inv_h;
-      dw[1] = inv_h;
+      dw[0] = zero - inv_h;
+      dw[1] = zero + inv_h;
+      w[2] = w[3] = dw[2] = dw[3] = zero;
       break;
     }
     case MPMC_BASIS_BSPLINE2: {
-      const int b = mpmc_ifloor(s - 0.5);
-      const double f = s - b; /* in [0.5, 1.5) */
-      const double x1 = f - 1.0;
-      *base = b;
+      sh = s - 0.5;
+      mpmc_floor4(&sh, base, &fl);
+      const mpmc_b4d f = s - fl; /* in [0.5, 1.5) */
+      const mpmc_b4d x1 = f - 1.0;
       w[0] = 0.5 * (1.5 - f) * (1.5 - f);
       w[1] = 0.75 - x1 * x1;
       w[2] = 0.5 * (f - 0.5) * (f - 0.5);
       dw[0] = -(1.5 - f) * inv_h;
       dw[1] = -2.0 * x1 * inv_h;
       dw[2] = (f - 0.5) * inv_h;
+      w[3] = dw[3] = zero;
       break;
     }
     case MPMC_BASIS_BSPLINE3: {
-      const int b = mpmc_ifloor(s) - 1;
-      const double f = s - b; /* in [1, 2) */
-      const double x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
+      mpmc_floor4(&s, base, &fl);
+      const mpmc_b4d b = fl - 1.0;
+      *base -= 1;
+      const mpmc_b4d f = s - b; /* in [1, 2) */
+      const mpmc_b4d x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
       /* node 0 at distance f, 1 at f-1, 2 at 2-f (negative side), 3 at 3-f */
-      *base = b;
       w[0] = x0 * x0 * x0 / 6.0;
       w[1] = 0.5 * x1 * x1 * x1 - x1 * x1 + 2.0 / 3.0;
       w[2] = 0.5 * x2 * x2 * x2 - x2 * x2 + 2.0 / 3.0;
@@ -85,33 +97,43 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       break;
     }
     default: { /* MPMC_BASIS_UGIMP, requires 0 < l <= 1/2 (above) */
-      const int b = mpmc_ifloor(s - 0.5);
-      const double f = s - b;
-      const double i2l = 0.5 / l, gi2l = i2l * inv_h;
-      *base = b;
-      const mpmc_b4d x = f - (mpmc_b4d){0.0, 1.0, 2.0, 3.0}, one = x * 0.0 + 1.0;
-      const mpmc_b4l sign = (mpmc_b4l)(-(one * 0.0)); /* -0.0: the sign bits */
-      mpmc_b4d u = x + l, v = x - l;
-      /* clamp to [-1, 1] exactly (outside the support both ends clamp alike and w = dw = 0) */
-#define CLAMP1_(y)                                                      \
-  do {                                                                  \
-    const mpmc_b4l hi_ = (y) > one, lo_ = (y) < -one;                   \
-    y = (mpmc_b4d)((hi_ & (mpmc_b4l)one) | (~hi_ & (mpmc_b4l)(y)));     \
-    y = (mpmc_b4d)((lo_ & (mpmc_b4l)(-one)) | (~lo_ & (mpmc_b4l)(y)));  \
-  } while (0)
-      CLAMP1_(u);
-      CLAMP1_(v);
-#undef CLAMP1_
-      const mpmc_b4d nu = one - (mpmc_b4d)((mpmc_b4l)u & ~sign); /* N(u) = 1 - |u| */
-      const mpmc_b4d nv = one - (mpmc_b4d)((mpmc_b4l)v & ~sign);
-      const mpmc_b4d uv = u * v;
-      const mpmc_b4d kink = (mpmc_b4d)((uv < x * 0.0) & (mpmc_b4l)(-uv));
-      const mpmc_b4d wv = ((u - v) * (nu + nv) * 0.5 + kink) * i2l;
-      const mpmc_b4d dv = (nu - nv) * gi2l;
-      memcpy(w, &wv, sizeof wv);
-      memcpy(dw, &dv, sizeof dv);
+      sh = s - 0.5;
+      mpmc_floor4(&sh, base, &fl);
+      const mpmc_b4d y = (s - fl) - 1.0;
+      const double i2l = 0.5 / l, i4l = 0.5 * i2l, gl = i2l * inv_h;
+      const mpmc_b4d lo = zero - l, hi = zero + l;
+      mpmc_b4d c = y;
+      c = (mpmc_b4d)(((mpmc_b4l)(c < lo) & (mpmc_b4l)lo) | (~(mpmc_b4l)(c < lo) & (mpmc_b4l)c));
+      c = (mpmc_b4d)(((mpmc_b4l)(c > hi) & (mpmc_b4l)hi) | (~(mpmc_b4l)(c > hi) & (mpmc_b4l)c));
+      const mpmc_b4d a = l - c, e = l + c, t0 = lo - y, t2 = y - l;
+      const mpmc_b4l sign = (mpmc_b4l)(mpmc_b4d){-0.0, -0.0, -0.0, -0.0}; /* the sign bits */
+      const mpmc_b4d d = (mpmc_b4d)((mpmc_b4l)(y - c) & ~sign); /* |y - c| */
+      w[0] = a * a * i4l + (mpmc_b4d)((mpmc_b4l)(t0 > zero) & (mpmc_b4l)t0);
+      w[1] = one - (c * c + l * l) * i2l - d;
+      w[2] = e * e * i4l + (mpmc_b4d)((mpmc_b4l)(t2 > zero) & (mpmc_b4l)t2);
+      dw[0] = (zero - a) * gl;
+      dw[1] = -2.0 * c * gl;
+      dw[2] = e * gl;
+      w[3] = dw[3] = zero;
       break;
     }
+  }
+}
+
+/* Weights w[k] and gradients dw[k] (d/dx_p, per metre) of nodes base..base+S-1 along one
+ * axis: mpmc_basis_axes on one lane.  s = (x_p - origin)/h; l = uGIMP half-length / h. */
+MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_h, int *base,
+                                      double *w, double *dw) {
+  mpmc_b4d wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL];
+  mpmc_b4i b;
+  const mpmc_b4d sv = {s, s, s, s};
+  mpmc_basis_axes(basis, &sv, l, inv_h, &b, wv, dv);
+  *base = b[0];
+  /* the stencil's nodes; uGIMP also the fourth (0), as its callers' arrays are that long */
+  const int nk = basis == MPMC_BASIS_UGIMP ? MPMC_MAX_STENCIL : mpmc_stencil(basis);
+  for (int k = 0; k < nk; ++k) {
+    w[k] = wv[k][0];
+    dw[k] = dv[k][0];
   }
 }
 

@@ -45,7 +45,7 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
     const mpmc_v2d cv = wyz * vv;
     double *restrict r = fb + row * 2;
-    for (int i = 0; i < S; ++i) MPMC_V2(r + 2 * i) += pw.w[0][i] * cv;
+    for (int i = 0; i < S; ++i) MPMC_V2(r + 2 * i) += pw.w[i][0] * cv;
   });
 }
 
@@ -90,7 +90,7 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
     const double *restrict r = fb + row * 2 + 1;
     double sr = 0.0;
-    for (int i = 0; i < S; ++i) sr += pw.w[0][i] * r[2 * i];
+    for (int i = 0; i < S; ++i) sr += pw.w[i][0] * r[2 * i];
     pi += wyz * sr;
   });
   apply_projection(p, DIM, q, pi);

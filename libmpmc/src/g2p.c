@@ -45,7 +45,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int k = 0; k < NC; ++k) sd[k] = zero;
     const double *restrict r = rec + row * R;
     for (int i = 0; i < S; ++i) {
-      const double wx = pw.w[0][i], dx = pw.dw[0][i];
+      const double wx = pw.w[i][0], dx = pw.dw[i][0];
       const double *ri = r + i * R;
       for (int k = 0; k < N1; ++k) sw[k] += wx * MPMC_VC(ri + MPMC_VW * k);
       for (int k = 0; k < NC; ++k) sd[k] += dx * MPMC_VC(ri + MPMC_VW * k);
@@ -92,7 +92,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       double *restrict f = FB == 1 ? fb + row * 2 : NULL;
       const mpmc_v2d cv = wyz * vv;
       for (int i = 0; i < S; ++i) {
-        const double wx = pw.w[0][i];
+        const double wx = pw.w[i][0];
         for (int k = N1; k < NV; ++k) sw[k] += wx * MPMC_VC(r + i * R + MPMC_VW * k);
         if (FB == 1) MPMC_V2(f + 2 * i) += wx * cv;
       }

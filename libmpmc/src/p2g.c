@@ -240,7 +240,7 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
     }
     double *restrict r = rec + row * R;
     for (int i = 0; i < S; ++i) {
-      const double wx = pw.w[0][i], dx = pw.dw[0][i];
+      const double wx = pw.w[i][0], dx = pw.dw[i][0];
       double *ri = r + i * R;
       for (int k = 0; k < NC; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k];
       for (int k = NC; k < NV; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k] + dx * e[k];

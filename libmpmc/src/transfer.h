@@ -11,20 +11,26 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 
 typedef struct {
-  size_t node0;                         /* linear index of the stencil's first node */
-  double w[3][MPMC_MAX_STENCIL];        /* 1D weights per axis                       */
-  double dw[3][MPMC_MAX_STENCIL];       /* 1D gradients per axis (per metre)         */
+  size_t node0;                        /* linear index of the stencil's first node      */
+  double w[MPMC_MAX_STENCIL][4];       /* 1D weights, [stencil node][axis]               */
+  double dw[MPMC_MAX_STENCIL][4];      /* 1D gradients (per metre), [stencil node][axis] */
 } mpmc_pw;
 
+/* All axes' weights in one evaluation (basis.h, mpmc_basis_axes). */
 MPMC_ALWAYS_INLINE void mpmc_point_weights(const int DIM, const int BASIS, const mpmc_grid *g,
                                            const double *x, double lp, mpmc_pw *pw) {
-  int base[3] = {0, 0, 0};
-  const double l = lp * g->inv_h;
-  for (int a = 0; a < DIM; ++a) {
-    const double s = (x[a] - g->origin[a]) * g->inv_h;
-    mpmc_basis_1d(BASIS, s, l, g->inv_h, &base[a], pw->w[a], pw->dw[a]);
+  const mpmc_b4d xv = {x[0], x[1], DIM == 3 ? x[2] : 0.0, 0.0};
+  const mpmc_b4d o = {g->origin[0], g->origin[1], DIM == 3 ? g->origin[2] : 0.0, 0.0};
+  mpmc_b4d w[MPMC_MAX_STENCIL], dw[MPMC_MAX_STENCIL];
+  mpmc_b4i base;
+  const mpmc_b4d s = (xv - o) * g->inv_h;
+  mpmc_basis_axes(BASIS, &s, lp * g->inv_h, g->inv_h, &base, w, dw);
+  for (int k = 0; k < mpmc_stencil(BASIS); ++k) {
+    memcpy(pw->w[k], &w[k], sizeof w[k]);
+    memcpy(pw->dw[k], &dw[k], sizeof dw[k]);
   }
-  pw->node0 = (size_t)base[0] + (size_t)g->n[0] * ((size_t)base[1] + (size_t)g->n[1] * (size_t)base[2]);
+  pw->node0 = (size_t)base[0] +
+              (size_t)g->n[0] * ((size_t)base[1] + (DIM == 3 ? (size_t)g->n[1] * (size_t)base[2] : 0));
 }
 
 /* Vectors of doubles (GCC/Clang vector extension) for the node records: the per-node updates
@@ -134,12 +140,12 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights(const int DIM, const int BASIS, cons
     const int S_ = mpmc_stencil(BASIS);                                                  \
     const size_t sy_ = (size_t)(g)->n[0], sz_ = (size_t)(g)->n[0] * (size_t)(g)->n[1];   \
     for (int k_ = 0; k_ < (DIM == 3 ? S_ : 1); ++k_) {                                   \
-      const double wz_ = DIM == 3 ? (pw).w[2][k_] : 1.0;                                 \
-      const double dz_ = DIM == 3 ? (pw).dw[2][k_] : 0.0;                                \
+      const double wz_ = DIM == 3 ? (pw).w[k_][2] : 1.0;                                 \
+      const double dz_ = DIM == 3 ? (pw).dw[k_][2] : 0.0;                                \
       for (int j_ = 0; j_ < S_; ++j_) {                                                  \
         const size_t row = (pw).node0 + sy_ * (size_t)j_ + sz_ * (size_t)k_;             \
-        const double wyz = (pw).w[1][j_] * wz_, dyz = (pw).dw[1][j_] * wz_;              \
-        const double ydz = (pw).w[1][j_] * dz_;                                          \
+        const double wyz = (pw).w[j_][1] * wz_, dyz = (pw).dw[j_][1] * wz_;              \
+        const double ydz = (pw).w[j_][1] * dz_;                                          \
         (void)wyz, (void)dyz, (void)ydz;                                                 \
         __VA_ARGS__                                                                      \
       }                                                                                  \
