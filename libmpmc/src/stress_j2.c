@@ -93,8 +93,10 @@ static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) 
  * A lane the iteration calls stiff (KINSOL's case), whose result fails the solve's checks or
  * ended on a round-off step (its residual needs libm's exp), or whose correction is beyond
  * the series, gets pl[l] = 0: mpmc_j2_plastic repeats it alone and reports or falls back. */
-static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, v4 qtr, v4 k0,
-                            int *pl, v4 *dg, v4 *be, v4 *es) {
+static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, const v4 *qtrp,
+                            const v4 *k0p, int *pl, v4 *dg, v4 *be, v4 *es) {
+  /* (vectors through pointers: by value they would change the baseline build's ABI) */
+  const v4 qtr = *qtrp, k0 = *k0p;
   const double kr = m->kappa_r, c = m->eta / (3.0 * m->G);
   const v4 a = k0 - kr;
   v4 lo = k0 * 0.0 + kr, hi = k0, y, rprev = k0 * 0.0 + INFINITY, tol;
@@ -265,7 +267,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
       }
       if (npl) {
         v4 dg, bn[6], es[6];
-        plastic4(&par, bt, e, qtrv, k0v, pl, &dg, bn, es);
+        plastic4(&par, bt, e, &qtrv, &k0v, pl, &dg, bn, es);
         for (int l = 0; l < 4; ++l) {
           if (!vec[l]) continue;
           if (!pl[l]) { /* handed back */
