@@ -12,17 +12,25 @@
 #define MPMC_ALWAYS_INLINE static inline __attribute__((always_inline))
 #define MPMC_MAX_STENCIL 4
 
+/* floor(s) as an int for |s| < 2^31: truncation corrected below zero.  libm's floor needs
+ * SSE4.1 to be inlined (not in the x86-64 baseline); this is three instructions. */
+MPMC_ALWAYS_INLINE int mpmc_ifloor(double s) {
+  const int i = (int)s;
+  return i - (s < (double)i);
+}
+
 /* nodes per axis in a point's support */
 MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
   return basis == MPMC_BASIS_LINEAR ? 2 : basis == MPMC_BASIS_BSPLINE3 ? 4 : 3;
 }
 
-/* The weights of one point along all axes at once: lane a of each vector is axis a (x, y,
- * z, and an unused fourth lane), and every basis is the same arithmetic on every lane, so one
- * evaluation in vectors of four doubles (one AVX2 register, two SSE2 ones) serves the three
- * axes.  s = (x_p - origin)/h per lane; l = uGIMP half-length / h (all axes).  Writes the
- * first stencil node per lane into base, and w[k], dw[k] (d/dx_p, per metre) of the k-th
- * node of each axis's stencil, k < MPMC_MAX_STENCIL (0 beyond the stencil).
+/* The uGIMP weights of one point along all axes at once: lane a of each vector is axis a
+ * (x, y, z, and an unused fourth lane), the same arithmetic on every lane, so one evaluation
+ * in vectors of four doubles (one AVX2 register, two SSE2 ones) serves the three axes (for
+ * the B-splines and the linear basis the scalar form per axis was the faster).
+ * s = (x_p - origin)/h per lane; l = half-length / h (all axes).  Writes the first stencil
+ * node per lane into base, and w[k], dw[k] (d/dx_p, per metre) of the k-th node of each
+ * axis's stencil, k < MPMC_MAX_STENCIL (0 for the fourth).
  *
  * uGIMP (0 < l <= 1/2): the hat N(x) = max(0, 1 - |x|) averaged over the point,
  * w = (1/2l) int_{x-l}^{x+l} N, with y the point's offset from the middle node of its three
@@ -40,8 +48,8 @@ typedef double mpmc_b4d __attribute__((vector_size(4 * sizeof(double))));
 typedef long long mpmc_b4l __attribute__((vector_size(4 * sizeof(long long))));
 typedef int mpmc_b4i __attribute__((vector_size(4 * sizeof(int))));
 
-/* floor per lane as doubles (|s| < 2^31), its int in *bi: truncation corrected below zero */
-/* (vectors through pointers: by value they would change the baseline build's ABI) */
+/* floor per lane as doubles (|s| < 2^31), its int in *bi: truncation corrected below zero
+ * (vectors through pointers: by value they would change the baseline build's ABI) */
 MPMC_ALWAYS_INLINE void mpmc_floor4(const mpmc_b4d *s, mpmc_b4i *bi, mpmc_b4d *fl) {
   const mpmc_b4i i = __builtin_convertvector(*s, mpmc_b4i);
   const mpmc_b4d d = __builtin_convertvector(i, mpmc_b4d);
@@ -50,42 +58,64 @@ MPMC_ALWAYS_INLINE void mpmc_floor4(const mpmc_b4d *s, mpmc_b4i *bi, mpmc_b4d *f
   *fl = d - (mpmc_b4d)(below & (mpmc_b4l)(mpmc_b4d){1.0, 1.0, 1.0, 1.0});
 }
 
-MPMC_ALWAYS_INLINE void mpmc_basis_axes(int basis, const mpmc_b4d *sp, double l, double inv_h,
-                                        mpmc_b4i *base, mpmc_b4d *w, mpmc_b4d *dw) {
+MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, double l, double inv_h, mpmc_b4i *base,
+                                        mpmc_b4d *w, mpmc_b4d *dw) {
   const mpmc_b4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0}, s = *sp;
-  mpmc_b4d fl, sh;
+  mpmc_b4d fl;
+  const mpmc_b4d sh = s - 0.5;
+  mpmc_floor4(&sh, base, &fl);
+  const mpmc_b4d y = (s - fl) - 1.0;
+  const double i2l = 0.5 / l, i4l = 0.5 * i2l, gl = i2l * inv_h;
+  const mpmc_b4d lo = zero - l, hi = zero + l;
+  mpmc_b4d c = y;
+  c = (mpmc_b4d)(((mpmc_b4l)(c < lo) & (mpmc_b4l)lo) | (~(mpmc_b4l)(c < lo) & (mpmc_b4l)c));
+  c = (mpmc_b4d)(((mpmc_b4l)(c > hi) & (mpmc_b4l)hi) | (~(mpmc_b4l)(c > hi) & (mpmc_b4l)c));
+  const mpmc_b4d a = l - c, e = l + c, t0 = lo - y, t2 = y - l;
+  const mpmc_b4l sign = (mpmc_b4l)(mpmc_b4d){-0.0, -0.0, -0.0, -0.0}; /* the sign bits */
+  const mpmc_b4d d = (mpmc_b4d)((mpmc_b4l)(y - c) & ~sign); /* |y - c| */
+  w[0] = a * a * i4l + (mpmc_b4d)((mpmc_b4l)(t0 > zero) & (mpmc_b4l)t0);
+  w[1] = one - (c * c + l * l) * i2l - d;
+  w[2] = e * e * i4l + (mpmc_b4d)((mpmc_b4l)(t2 > zero) & (mpmc_b4l)t2);
+  dw[0] = (zero - a) * gl;
+  dw[1] = -2.0 * c * gl;
+  dw[2] = e * gl;
+  w[3] = dw[3] = zero;
+}
+
+/* Weights w[k] and gradients dw[k] (d/dx_p, per metre) of nodes base..base+S-1 along one
+ * axis.  s = (x_p - origin)/h; l = uGIMP half-length / h. */
+MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_h, int *base,
+                                      double *w, double *dw) {
   switch (basis) {
     case MPMC_BASIS_LINEAR: {
-      mpmc_floor4(&s, base, &fl);
-      const mpmc_b4d f = s - fl;
-      w[0] = one - f;
+      const int b = mpmc_ifloor(s);
+      const double f = s - b;
+      *base = b;
+      w[0] = 1.0 - f;
       w[1] = f;
-      dw[0] = zero - inv_h;
-      dw[1] = zero + inv_h;
-      w[2] = w[3] = dw[2] = dw[3] = zero;
+      dw[0] = -inv_h;
+      dw[1] = inv_h;
       break;
     }
     case MPMC_BASIS_BSPLINE2: {
-      sh = s - 0.5;
-      mpmc_floor4(&sh, base, &fl);
-      const mpmc_b4d f = s - fl; /* in [0.5, 1.5) */
-      const mpmc_b4d x1 = f - 1.0;
+      const int b = mpmc_ifloor(s - 0.5);
+      const double f = s - b; /* in [0.5, 1.5) */
+      const double x1 = f - 1.0;
+      *base = b;
       w[0] = 0.5 * (1.5 - f) * (1.5 - f);
       w[1] = 0.75 - x1 * x1;
       w[2] = 0.5 * (f - 0.5) * (f - 0.5);
       dw[0] = -(1.5 - f) * inv_h;
       dw[1] = -2.0 * x1 * inv_h;
       dw[2] = (f - 0.5) * inv_h;
-      w[3] = dw[3] = zero;
       break;
     }
     case MPMC_BASIS_BSPLINE3: {
-      mpmc_floor4(&s, base, &fl);
-      const mpmc_b4d b = fl - 1.0;
-      *base -= 1;
-      const mpmc_b4d f = s - b; /* in [1, 2) */
-      const mpmc_b4d x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
+      const int b = mpmc_ifloor(s) - 1;
+      const double f = s - b; /* in [1, 2) */
+      const double x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
       /* node 0 at distance f, 1 at f-1, 2 at 2-f (negative side), 3 at 3-f */
+      *base = b;
       w[0] = x0 * x0 * x0 / 6.0;
       w[1] = 0.5 * x1 * x1 * x1 - x1 * x1 + 2.0 / 3.0;
       w[2] = 0.5 * x2 * x2 * x2 - x2 * x2 + 2.0 / 3.0;
@@ -96,44 +126,19 @@ MPMC_ALWAYS_INLINE void mpmc_basis_axes(int basis, const mpmc_b4d *sp, double l,
       dw[3] = 0.5 * x3 * x3 * inv_h;
       break;
     }
-    default: { /* MPMC_BASIS_UGIMP, requires 0 < l <= 1/2 (above) */
-      sh = s - 0.5;
-      mpmc_floor4(&sh, base, &fl);
-      const mpmc_b4d y = (s - fl) - 1.0;
-      const double i2l = 0.5 / l, i4l = 0.5 * i2l, gl = i2l * inv_h;
-      const mpmc_b4d lo = zero - l, hi = zero + l;
-      mpmc_b4d c = y;
-      c = (mpmc_b4d)(((mpmc_b4l)(c < lo) & (mpmc_b4l)lo) | (~(mpmc_b4l)(c < lo) & (mpmc_b4l)c));
-      c = (mpmc_b4d)(((mpmc_b4l)(c > hi) & (mpmc_b4l)hi) | (~(mpmc_b4l)(c > hi) & (mpmc_b4l)c));
-      const mpmc_b4d a = l - c, e = l + c, t0 = lo - y, t2 = y - l;
-      const mpmc_b4l sign = (mpmc_b4l)(mpmc_b4d){-0.0, -0.0, -0.0, -0.0}; /* the sign bits */
-      const mpmc_b4d d = (mpmc_b4d)((mpmc_b4l)(y - c) & ~sign); /* |y - c| */
-      w[0] = a * a * i4l + (mpmc_b4d)((mpmc_b4l)(t0 > zero) & (mpmc_b4l)t0);
-      w[1] = one - (c * c + l * l) * i2l - d;
-      w[2] = e * e * i4l + (mpmc_b4d)((mpmc_b4l)(t2 > zero) & (mpmc_b4l)t2);
-      dw[0] = (zero - a) * gl;
-      dw[1] = -2.0 * c * gl;
-      dw[2] = e * gl;
-      w[3] = dw[3] = zero;
+    default: { /* MPMC_BASIS_UGIMP: one lane of mpmc_ugimp_axes, and the fourth node (0), as
+                  its callers' arrays are that long */
+      mpmc_b4d wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL];
+      mpmc_b4i b;
+      const mpmc_b4d sv = {s, s, s, s};
+      mpmc_ugimp_axes(&sv, l, inv_h, &b, wv, dv);
+      *base = b[0];
+      for (int k = 0; k < MPMC_MAX_STENCIL; ++k) {
+        w[k] = wv[k][0];
+        dw[k] = dv[k][0];
+      }
       break;
     }
-  }
-}
-
-/* Weights w[k] and gradients dw[k] (d/dx_p, per metre) of nodes base..base+S-1 along one
- * axis: mpmc_basis_axes on one lane.  s = (x_p - origin)/h; l = uGIMP half-length / h. */
-MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_h, int *base,
-                                      double *w, double *dw) {
-  mpmc_b4d wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL];
-  mpmc_b4i b;
-  const mpmc_b4d sv = {s, s, s, s};
-  mpmc_basis_axes(basis, &sv, l, inv_h, &b, wv, dv);
-  *base = b[0];
-  /* the stencil's nodes; uGIMP also the fourth (0), as its callers' arrays are that long */
-  const int nk = basis == MPMC_BASIS_UGIMP ? MPMC_MAX_STENCIL : mpmc_stencil(basis);
-  for (int k = 0; k < nk; ++k) {
-    w[k] = wv[k][0];
-    dw[k] = dv[k][0];
   }
 }
 

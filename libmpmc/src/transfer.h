@@ -16,21 +16,34 @@ typedef struct {
   double dw[MPMC_MAX_STENCIL][4];      /* 1D gradients (per metre), [stencil node][axis] */
 } mpmc_pw;
 
-/* All axes' weights in one evaluation (basis.h, mpmc_basis_axes). */
+/* uGIMP: all axes in one evaluation (basis.h, mpmc_ugimp_axes); the polynomial bases axis by
+ * axis (their scalar form was the faster: B-spline2 + F-bar 6.00 against 5.40 M/s). */
 MPMC_ALWAYS_INLINE void mpmc_point_weights(const int DIM, const int BASIS, const mpmc_grid *g,
                                            const double *x, double lp, mpmc_pw *pw) {
-  const mpmc_b4d xv = {x[0], x[1], DIM == 3 ? x[2] : 0.0, 0.0};
-  const mpmc_b4d o = {g->origin[0], g->origin[1], DIM == 3 ? g->origin[2] : 0.0, 0.0};
-  mpmc_b4d w[MPMC_MAX_STENCIL], dw[MPMC_MAX_STENCIL];
-  mpmc_b4i base;
-  const mpmc_b4d s = (xv - o) * g->inv_h;
-  mpmc_basis_axes(BASIS, &s, lp * g->inv_h, g->inv_h, &base, w, dw);
-  for (int k = 0; k < mpmc_stencil(BASIS); ++k) {
-    memcpy(pw->w[k], &w[k], sizeof w[k]);
-    memcpy(pw->dw[k], &dw[k], sizeof dw[k]);
+  int base[3] = {0, 0, 0};
+  if (BASIS == MPMC_BASIS_UGIMP) {
+    const mpmc_b4d xv = {x[0], x[1], DIM == 3 ? x[2] : 0.0, 0.0};
+    const mpmc_b4d o = {g->origin[0], g->origin[1], DIM == 3 ? g->origin[2] : 0.0, 0.0};
+    const mpmc_b4d s = (xv - o) * g->inv_h;
+    mpmc_b4d w[MPMC_MAX_STENCIL], dw[MPMC_MAX_STENCIL];
+    mpmc_b4i b;
+    mpmc_ugimp_axes(&s, lp * g->inv_h, g->inv_h, &b, w, dw);
+    for (int k = 0; k < 3; ++k) {
+      memcpy(pw->w[k], &w[k], sizeof w[k]);
+      memcpy(pw->dw[k], &dw[k], sizeof dw[k]);
+    }
+    for (int a = 0; a < DIM; ++a) base[a] = b[a];
+  } else {
+    for (int a = 0; a < DIM; ++a) {
+      double w[MPMC_MAX_STENCIL], dw[MPMC_MAX_STENCIL];
+      mpmc_basis_1d(BASIS, (x[a] - g->origin[a]) * g->inv_h, 0.0, g->inv_h, &base[a], w, dw);
+      for (int k = 0; k < mpmc_stencil(BASIS); ++k) {
+        pw->w[k][a] = w[k];
+        pw->dw[k][a] = dw[k];
+      }
+    }
   }
-  pw->node0 = (size_t)base[0] +
-              (size_t)g->n[0] * ((size_t)base[1] + (DIM == 3 ? (size_t)g->n[1] * (size_t)base[2] : 0));
+  pw->node0 = (size_t)base[0] + (size_t)g->n[0] * ((size_t)base[1] + (size_t)g->n[1] * (size_t)base[2]);
 }
 
 /* Vectors of doubles (GCC/Clang vector extension) for the node records: the per-node updates
