@@ -67,15 +67,16 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, double l, double inv
   const mpmc_b4d y = (s - fl) - 1.0;
   const double i2l = 0.5 / l, i4l = 0.5 * i2l, gl = i2l * inv_h;
   const mpmc_b4d lo = zero - l, hi = zero + l;
-  mpmc_b4d c = y;
-  c = (mpmc_b4d)(((mpmc_b4l)(c < lo) & (mpmc_b4l)lo) | (~(mpmc_b4l)(c < lo) & (mpmc_b4l)c));
-  c = (mpmc_b4d)(((mpmc_b4l)(c > hi) & (mpmc_b4l)hi) | (~(mpmc_b4l)(c > hi) & (mpmc_b4l)c));
+/* lanes of a where mask m is set, else of b */
+#define SEL4_(m, a, b) ((mpmc_b4d)(((m) & (mpmc_b4l)(a)) | (~(m) & (mpmc_b4l)(b))))
+  const mpmc_b4d c0 = SEL4_(y < lo, lo, y), c = SEL4_(c0 > hi, hi, c0); /* y in [-l, l] */
   const mpmc_b4d a = l - c, e = l + c, t0 = lo - y, t2 = y - l;
   const mpmc_b4l sign = (mpmc_b4l)(mpmc_b4d){-0.0, -0.0, -0.0, -0.0}; /* the sign bits */
   const mpmc_b4d d = (mpmc_b4d)((mpmc_b4l)(y - c) & ~sign); /* |y - c| */
-  w[0] = a * a * i4l + (mpmc_b4d)((mpmc_b4l)(t0 > zero) & (mpmc_b4l)t0);
+  w[0] = a * a * i4l + SEL4_(t0 > zero, t0, zero);
   w[1] = one - (c * c + l * l) * i2l - d;
-  w[2] = e * e * i4l + (mpmc_b4d)((mpmc_b4l)(t2 > zero) & (mpmc_b4l)t2);
+  w[2] = e * e * i4l + SEL4_(t2 > zero, t2, zero);
+#undef SEL4_
   dw[0] = (zero - a) * gl;
   dw[1] = -2.0 * c * gl;
   dw[2] = e * gl;

@@ -52,10 +52,10 @@ static inline double rm_r(const mpmc_j2_param *m, double qtr, double ep0, double
   return y - (m->kappa_r + e);
 }
 
-/* Converged when |r| is below 1e-12 of the residual strength (or round-off of kappa). */
-static inline double rm_tol(const mpmc_j2_param *m, double kappa0) { return mpmc_rm_tol_k(m, kappa0); }
+/* Converged when |r| is below 1e-12 of the residual strength (or round-off of kappa):
+ * mpmc_rm_tol_k (return_map.h, stress_j2.c's too). */
 double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p) {
-  return rm_tol(m, mpmc_j2_kappa(m, eps_p));
+  return mpmc_rm_tol_k(m, mpmc_j2_kappa(m, eps_p));
 }
 
 /* ---- KINSOL ------------------------------------------------------------------------- */
@@ -260,7 +260,7 @@ int mpmc_rm_solve_k(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, double q
   info->kappa = k0;
   if (!(isfinite(qtr) && isfinite(k0) && isfinite(m->G) && m->G > 0)) return MPMC_ERR_NUMERIC;
   if (!(qtr > k0)) return MPMC_ERR_ARG; /* elastic: nothing to solve */
-  const double tol = rm_tol(m, k0);
+  const double tol = mpmc_rm_tol_k(m, k0);
   /* bracket of y (return_map.h): r(kappa_r) <= 0 <= r(kappa(eps_p)) */
   double lo = m->kappa_r, hi = k0;
   if (hi < lo) hi = lo;

@@ -242,12 +242,12 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
       /* J = sqrt(det b) = exp(tr eps), without the exp */
       const v4 detb = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
                       bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
-      /* elastic lanes finish here; with the auto solver the plastic ones go on together
-       * (plastic4), the rest and any plastic4 hands back one by one (scalar) */
-      int pl[4] = {0, 0, 0, 0}, npl = 0, vec[4] = {0, 0, 0, 0}, scalar[4] = {0, 0, 0, 0};
+      /* elastic lanes finish here (the rest: todo); with the auto solver the plastic ones go
+       * on together (plastic4, pl), the others and any plastic4 hands back one by one */
+      int todo[4] = {0, 0, 0, 0}, pl[4] = {0, 0, 0, 0}, npl = 0;
       v4 k0v, qtrv;
       for (int l = 0; l < 4; ++l) {
-        k0v[l] = qtrv[l] = 1.0;
+        k0v[l] = qtrv[l] = 1.0; /* finite dummies for plastic4's unused lanes */
         if (!act[l]) continue;
         const int q = q0 + l;
         const double k0 = mpmc_j2_kappa(&par, p->eps_p[q]);
@@ -261,19 +261,15 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           continue;
         }
         k0v[l] = k0, qtrv[l] = qtr;
+        todo[l] = 1;
         pl[l] = solver == MPMC_SOLVER_AUTO && !fail[l] && isfinite(qtr) && detb[l] > 0.0;
-        npl += vec[l] = pl[l];
-        scalar[l] = !pl[l];
+        npl += pl[l];
       }
       if (npl) {
         v4 dg, bn[6], es[6];
         plastic4(&par, bt, e, &qtrv, &k0v, pl, &dg, bn, es);
         for (int l = 0; l < 4; ++l) {
-          if (!vec[l]) continue;
-          if (!pl[l]) { /* handed back */
-            scalar[l] = 1;
-            continue;
-          }
+          if (!pl[l]) continue; /* not plastic4's, or handed back */
           const int q = q0 + l;
           double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
           for (int k = 0; k < 6; ++k) be[k] = bn[k][l];
@@ -281,7 +277,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           /* tau as mpmc_j2_plastic's (series_tau), sigma = tau / J, J = sqrt(det b) */
           const double inv_J = 1.0 / sqrt(detb[l]);
           for (int k = 0; k < 6; ++k) {
-            double t = 2.0 * par.G * es[k][l];
+            double t = G2 * es[k][l];
             if (k < 3) t += K * tr[l];
             sg[k] = t * inv_J;
           }
@@ -289,7 +285,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         }
       }
       for (int l = 0; l < 4; ++l) {
-        if (!act[l] || !scalar[l]) continue;
+        if (!todo[l] || pl[l]) continue;
         const int q = q0 + l;
         double *ep = p->eps_p + q;
         const double k0 = k0v[l], qtr = qtrv[l];
