@@ -16,7 +16,7 @@
  * called on its own (tests) the projection scatters here, recovering V_p as V0 J^{n+1} / dJ
  * (G2P has already updated J).  The scatter
  * leaves Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
- * Touches nothing but dF (handed to the material), Jbar and the grid's fb. */
+ * Touches nothing but dF (handed to the material), Jbar and the grid's fb and fbj. */
 #include <math.h>
 #include <string.h>
 
@@ -68,32 +68,38 @@ static inline double cbrt_near1(double r) {
 }
 
 /* Point q's projected Jacobian pi: scale dF by (pi / (Jbar^n dJ))^(1/dim) (eq 27; the
- * scatter left Jbar^n dJ in Jbar), keep pi as Jbar. */
-MPMC_ALWAYS_INLINE void apply_projection(mpmc_particles *p, const int DIM, int q, double pi) {
+ * scatter left Jbar^n dJ in Jbar, inv = its reciprocal: taken by the callers before the
+ * gather, the division runs beside it instead of after it), keep pi as Jbar. */
+MPMC_ALWAYS_INLINE void apply_projection(mpmc_particles *p, const int DIM, int q, double pi,
+                                         double inv) {
   double *dF = p->dF + (size_t)q * DIM * DIM;
-  const double r = pi / p->Jbar[q];
+  const double r = pi * inv;
   const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
   for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
   p->Jbar[q] = pi;
 }
 
-/* Gather point q: Pi = sum w Jbar_i, scale dF (Algorithm 1, step 4). */
+/* four doubles at p, unaligned, aliasing (the gather's row loads) */
+typedef double fb_v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
+
+/* Gather point q: Pi = sum w Jbar_i, scale dF (Algorithm 1, step 4).  Every row of the
+ * stencil has the same x-weights, so Pi = sum_i wx_i (sum_rows wyz J_row+i): a row's nodes
+ * are four contiguous doubles of fbj (the stencil's, zero-weighted beyond it), one
+ * multiply-add per row, one dot product at the end. */
 MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const int S = mpmc_stencil(BASIS);
-  const double *restrict fb = g->fb;
+  const double *restrict jb = g->fbj;
+  const double inv = 1.0 / p->Jbar[q];
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  mpmc_b4d acc = {0.0, 0.0, 0.0, 0.0};
+  MPMC_ROW_LOOP(DIM, BASIS, g, pw, { acc += wyz * *(const fb_v4u *)(jb + row); });
   double pi = 0.0;
-  MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
-    const double *restrict r = fb + row * 2 + 1;
-    double sr = 0.0;
-    for (int i = 0; i < S; ++i) sr += pw.w[i][0] * r[2 * i];
-    pi += wyz * sr;
-  });
-  apply_projection(p, DIM, q, pi);
+  for (int i = 0; i < S; ++i) pi += pw.w[i][0] * acc[i];
+  apply_projection(p, DIM, q, pi, inv);
 }
 
 MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
@@ -110,11 +116,12 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double *restrict fb = g->fb;
+  const double inv = 1.0 / p->Jbar[q];
   mpmc_spw sp;
   mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
   double pi = 0.0;
   MPMC_STABLE_LOOP(DIM, BASIS, sp, { pi += w * fb[2 * node + 1]; });
-  apply_projection(p, DIM, q, pi);
+  apply_projection(p, DIM, q, pi, inv);
 }
 
 /* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
@@ -169,7 +176,8 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
     double *f = fb + 2 * mpmc_grid_active_row(g, r);
-    for (size_t i = 0; i < 2 * len; i += 2) f[i + 1] = f[i] > 0.0 ? f[i + 1] / f[i] : 0.0;
+    double *fj = g->fbj + mpmc_grid_active_row(g, r);
+    for (size_t i = 0; i < len; ++i) fj[i] = f[2 * i + 1] = f[2 * i] > 0.0 ? f[2 * i + 1] / f[2 * i] : 0.0;
   }
   if (stable)
     MPMC_KERNEL_CALL(gather_stable_, sim, sim);

@@ -60,6 +60,7 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
   const size_t nn = g->nn;
   MPMC_CALL(alloc_d(ctx, &g->node, nn * MPMC_NREC));
   if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fb, nn * 2));
+  if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fbj, nn + 4)); /* the gather reads 4 from a row start */
   if (!g->fixed) {
     g->fixed = calloc(nn, sizeof *g->fixed);
     MPMC_CHECK(g->fixed, ctx, MPMC_ERR_MEMORY, "cannot allocate %zu grid flags", nn);
@@ -103,10 +104,11 @@ void mpmc_grid_free(mpmc_grid *g) {
   free(g->node);
   free(g->priv);
   free(g->fb);
+  free(g->fbj);
   free(g->fixed);
   free(g->ccount);
   free(g->fbpriv);
-  g->node = g->fb = g->priv = g->fbpriv = NULL;
+  g->node = g->fb = g->fbj = g->priv = g->fbpriv = NULL;
   g->fixed = NULL;
   g->ccount = NULL;
   g->cap_ccount = g->cap_priv = g->cap_fbpriv = 0;
