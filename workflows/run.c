@@ -415,7 +415,7 @@ static int checkpoint(wf_run *w, int stage, double t_stage, long steps, double k
 
 /* A step failed (the monitor's energy check, NaN, J <= 0, a point leaving the grid, a dt
  * above the limit): the state in memory is the failing one.  The last good state is the
- * newest checkpoint.h5 (written at the start, at every stage end and every
+ * newest checkpoint.h5 (written at the start, at the end of every stage but the last, and every
  * checkpoint_interval), left untouched; copying the state before every step instead would
  * cost a full copy of the particles per step.  The failing state is appended to the
  * snapshots for inspection. */
