@@ -41,16 +41,14 @@ for k in 0 1 2 3; do
   t0=$($py -c "import h5py,re; m=h5py.File('$work/s$k/checkpoint.h5','r').attrs['meta'].decode(); print(re.search(r'stage_time (\S+)', m).group(1))")
   $tile "$work/s$k" "$work/f$k" 25 "$(awk "BEGIN{printf \"%.10g\", $t0 + $dt}")" "$threads"
   "$bin" resume "$work/f$k" --quiet
-  $py - "$work/f$k" "$work/s$k" "$steps" <<'EOF'
+  $py - "$work/f$k" "$work/s$k" "$steps" "$t0" <<'EOF'
 import h5py, json, sys
-out, src, steps = sys.argv[1], sys.argv[2], int(sys.argv[3])
+out, src, steps, t0 = sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4])
 s = json.load(open(out + "/summary.json"))
-names = ["sort", "slabs", "p2g", "grid", "g2p", "fbar", "stress", "checks"]
+names = list(s["phase_seconds"])  # the order of the checkpoint's stats_phase_seconds
 before = h5py.File(src + "/checkpoint.h5", "r")["config"].attrs["stats_phase_seconds"]
 ph = {n: s["phase_seconds"][n] - b for n, b in zip(names, before)}
 tot = sum(ph.values())
-import re
-t0 = float(re.search(r"stage_time (\S+)", h5py.File(src + "/checkpoint.h5", "r").attrs["meta"].decode()).group(1))
 print("run-out %.2f s: %d steps %.2f s (%.2f ms/step, 110,000 steps %.1f min) | " %
       (t0, steps, tot, 1e3 * tot / steps, tot / steps * 110000 / 60) +
       " ".join("%s %.2f" % (n, v) for n, v in ph.items()))

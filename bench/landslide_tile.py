@@ -10,6 +10,7 @@ same state, point for point (docs/landslide.md).  OUT_DIR/checkpoint.h5 is that 
 the run-out stage to end at END_TIME (stage time, s) on THREADS threads; `mpmc resume OUT_DIR`
 continues it.  Needs h5py (Debian: python3-h5py).
 """
+import os
 import re
 import shutil
 import sys
@@ -19,7 +20,6 @@ import numpy as np
 
 
 def main(src, dst, copies, end_time, threads):
-    import os
     os.makedirs(dst, exist_ok=True)
     shutil.copy(os.path.join(src, "checkpoint.h5"), os.path.join(dst, "checkpoint.h5"))
     width = 0.2

@@ -84,7 +84,7 @@ typedef double fb_v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8)
 
 /* Gather point q: Pi = sum w Jbar_i, scale dF (Algorithm 1, step 4).  Every row of the
  * stencil has the same x-weights, so Pi = sum_i wx_i (sum_rows wyz J_row+i): a row's nodes
- * are four contiguous doubles of fbj (the stencil's, zero-weighted beyond it), one
+ * are four contiguous doubles of fbj (those beyond the stencil unused), one
  * multiply-add per row, one dot product at the end. */
 MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   const mpmc_grid *g = &sim->grid;
@@ -115,12 +115,12 @@ MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const 
 MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
-  const double *restrict fb = g->fb;
+  const double *restrict jb = g->fbj;
   const double inv = 1.0 / p->Jbar[q];
   mpmc_spw sp;
   mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
   double pi = 0.0;
-  MPMC_STABLE_LOOP(DIM, BASIS, sp, { pi += w * fb[2 * node + 1]; });
+  MPMC_STABLE_LOOP(DIM, BASIS, sp, { pi += w * jb[node]; });
   apply_projection(p, DIM, q, pi, inv);
 }
 
@@ -169,15 +169,16 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
       MPMC_KERNEL_CALL(scatter_, sim, sim);
   }
   g->fb_done = 0;
-  /* nodal volume average (Algorithm 1 step 3), row by row */
+  /* nodal volume average (Algorithm 1 step 3) into fbj, row by row */
   const long nrow = mpmc_grid_active_rows(g);
   const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
-  double *restrict fb = g->fb;
+  const double *restrict fb = g->fb;
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
-    double *f = fb + 2 * mpmc_grid_active_row(g, r);
-    double *fj = g->fbj + mpmc_grid_active_row(g, r);
-    for (size_t i = 0; i < len; ++i) fj[i] = f[2 * i + 1] = f[2 * i] > 0.0 ? f[2 * i + 1] / f[2 * i] : 0.0;
+    const size_t first = mpmc_grid_active_row(g, r);
+    const double *f = fb + 2 * first;
+    double *fj = g->fbj + first;
+    for (size_t i = 0; i < len; ++i) fj[i] = f[2 * i] > 0.0 ? f[2 * i + 1] / f[2 * i] : 0.0;
   }
   if (stable)
     MPMC_KERNEL_CALL(gather_stable_, sim, sim);

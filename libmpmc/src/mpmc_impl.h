@@ -98,10 +98,10 @@ typedef struct {
   size_t nn;           /* total nodes                                              */
   double *node;        /* [nn][MPMC_NREC] mass, momentum, f_int + f_ext (slots above); after
                           the grid update mass, new velocity, velocity increment         */
-  double *fb;          /* [nn][2] F-bar: sum w V, sum w V (Jbar dJ) then nodal Jbar   */
-  double *fbj;         /* [nn + 4] F-bar: the nodal Jbar alone, for the gather's rows of
-                          contiguous loads (fbar.c); zero at allocation, written in the
-                          active box, finite wherever written                            */
+  double *fb;          /* [nn][2] F-bar: sum w V, sum w V (Jbar dJ)                    */
+  double *fbj;         /* [nn + 4] F-bar: the nodal Jbar, their ratio, written in the active
+                          box (fbar.c); the gather loads rows of four from a row's first
+                          node, the lanes beyond the stencil unused                      */
   unsigned short *fixed; /* [nn] bit a: component a fixed; bit 3+a: v_a >= 0 only; bit 6+a: v_a <= 0 only */
   /* node index box [act_lo, act_hi) per axis outside which node and fb are zero: the points'
    * stencils of the last P2G (and the mirror partners the grid update folded into); P2G
