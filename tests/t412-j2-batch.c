@@ -7,7 +7,8 @@
  * plastic points the blocks return four at a time, stress_j2.c's plastic4) b_e, eps_p and the
  * stress agree to 1e-12, the counts of plastic corrections and KINSOL fallbacks match, both
  * instruction sets give the same bits, and a point with a non-finite dF fails the update
- * with its own index in the message. */
+ * with its own index in the message; the blocks keep the step's guard against non-finite
+ * stresses. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -200,7 +201,49 @@ static void test_batch_equals_scalar(void **state) {
   }
 }
 
+/* The step's stress guard (stress_update.c) kept by the blocks themselves: points whose
+ * elastic stress overflows stop the update with MPMC_ERR_NUMERIC naming the lowest of them,
+ * from the J2 blocks' own check with Hencky-J2 alone, from the pass over the stresses with a
+ * Hencky material beside it.  3D, K = 1.7e308, dF = 0.9 I (beyond the blocks' series: the
+ * scalar return map's lanes; an elastic lane within it cannot overflow with a finite K): the
+ * normal components, -7e307 each, add up to -inf (2D's plane strain stays finite). */
+static void guard(int dim, int with_hencky) {
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  mpmc_sim sim;
+  TCALL(mpmc_sim_create(ctx, dim, &sim));
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
+  int m, h;
+  TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e304, 0.49999, 2000, 1e307, 1e307, 0, &m));
+  if (with_hencky) TCALL(mpmc_sim_add_material_hencky(sim, 1e7, 0.3, 2000, &h));
+  for (int q = 0; q < NP; ++q) {
+    const double x[3] = {0.3 + 0.004 * q, 0.5, 0.5}, v = 1e-4;
+    TCALL(mpmc_sim_add_particles(sim, 1, x, &v, m, NULL));
+  }
+  TCALL(mpmc_sim_prepare(sim));
+  mpmc_particles *p = &sim->p;
+  for (int q = 0; q < NP; ++q)
+    for (int k = 0; k < dim * dim; ++k)
+      p->dF[q * dim * dim + k] = k % (dim + 1) ? 0.0 : (q == 37 || q == 80 ? 0.9 : 1.0);
+  const int e = mpmc_stress_update(sim, 1e-3);
+  if (e != MPMC_ERR_NUMERIC || !strstr(mpmc_context_last_error(ctx), "point 37 at") ||
+      !strstr(mpmc_context_last_error(ctx), "non-finite stress"))
+    fail_msg("dim %d%s: code %d, '%s'", dim, with_hencky ? " with Hencky" : "", e,
+             mpmc_context_last_error(ctx));
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+  test_ctx = NULL;
+}
+
+static void test_stress_guard(void **state) {
+  (void)state;
+  for (int h = 0; h < 2; ++h) guard(3, h);
+}
+
 int main(void) {
-  const struct CMUnitTest tests[] = {cmocka_unit_test(test_batch_equals_scalar)};
+  const struct CMUnitTest tests[] = {cmocka_unit_test(test_batch_equals_scalar),
+                                     cmocka_unit_test(test_stress_guard)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

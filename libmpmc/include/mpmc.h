@@ -112,7 +112,8 @@ typedef enum {
   MPMC_PHASE_P2G = 2,     /* mass, momentum and forces onto the grid                     */
   MPMC_PHASE_GRID = 3,    /* grid velocities, walls, damping                             */
   MPMC_PHASE_G2P = 4,     /* velocities, deformation, positions (with F-bar's scatter)   */
-  MPMC_PHASE_FBAR = 5,    /* F-bar's nodal average and gather                             */
+  MPMC_PHASE_FBAR = 5,    /* F-bar's nodal average and gather (Hencky-J2 alone: the
+                             gather runs in the material update, MPMC_PHASE_STRESS)      */
   MPMC_PHASE_STRESS = 6,  /* the material update                                         */
   MPMC_PHASE_CHECKS = 7,  /* stability limit, rigid bodies' contact, run monitor         */
   MPMC_PHASE_COUNT = 8

@@ -181,7 +181,7 @@ static int unattached_update(struct mpmc_sim_s *sim, const mpmc_material *mat, i
 }
 static double unattached_wave_speed(const mpmc_material *m) { return m->user_wave_speed; }
 static const mpmc_material_ops ops_unattached = {"user (unattached)", unattached_update,
-                                                 unattached_wave_speed};
+                                                 unattached_wave_speed, 0, 0};
 
 static int read_materials(hid_t f, mpmc_sim sim) {
   mpmc_context ctx = sim->ctx;

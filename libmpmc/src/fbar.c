@@ -1,5 +1,6 @@
 /* The F-bar projection (paper Algorithm 1, eqs 19-27), run only when enabled:
  *   scatter  V_i = sum w V_p,  (V J)_i = sum w V_p j_p                          (step 3)
+ *   average  Jbar_i = (V J)_i / V_i                                             (step 3)
  *   gather   Pi_p = sum w Jbar_i,  dFbar = (Pi_p / (Jbar_p^n dJ_p))^(1/dim) dF (step 4)
  * with j_p = Jbar_p^n dJ_p in MPMC_FBAR_PAPER (eq 26, Algorithm 1 as published) and
  * j_p = J_p^{n+1} = det F in MPMC_FBAR_TOTAL (eqs 18-21: the projection of the Jacobian
@@ -11,12 +12,15 @@
  * the grid of spacing 2h (nodes x = lo, lo + 2h, ...) for linear and uGIMP, linear hats
  * centred on the cells for quadratic B-splines, quadratic B-splines centred on the cells for
  * cubic ones.  With w the weights of that space the formulas above are unchanged.
- * V_p is the volume at t^n.  In a step the scatter runs fused into G2P (which has the
- * points at x^n and, but in the stable form, the weights at hand; it sets grid.fb_done);
- * called on its own (tests) the projection scatters here, recovering V_p as V0 J^{n+1} / dJ
- * (G2P has already updated J).  The scatter
- * leaves Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
- * Touches nothing but dF (handed to the material), Jbar and the grid's fb and fbj. */
+ * V_p is the volume at t^n.  In a step the scatter runs fused into the transfers, which have
+ * the points at x^n and, but in the stable form, the weights at hand: in the paper and total
+ * forms P2G adds V_i to the node records (slot MPMC_VSLOT, beside the mass) and G2P (V J)_i to
+ * fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P sets
+ * grid.fb_done.  Called on its own (tests) the projection scatters here, recovering V_p as
+ * V0 J^{n+1} / dJ (G2P has already updated J).  The scatter leaves Jbar^n dJ in Jbar for
+ * the gather, which replaces it with Pi.
+ * Touches nothing but dF (handed to the material), Jbar, the grid's fb and fbj and the
+ * records' MPMC_VSLOT. */
 #include <math.h>
 #include <string.h>
 
@@ -32,20 +36,23 @@ MPMC_ALWAYS_INLINE mpmc_v2d scatter_values(mpmc_sim sim, const int DIM, int q) {
   return (mpmc_v2d){Vn, Vn * (sim->fbar == MPMC_FBAR_PAPER ? p->Jbar[q] : p->J[q])};
 }
 
-/* Scatter point q: V^n and V^n j onto its nodes (Algorithm 1, step 3). */
+/* Scatter point q: V^n and V^n j onto its nodes (Algorithm 1, step 3), where P2G and G2P
+ * put them in a step: the records' MPMC_VSLOT and fbj. */
 MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int S = mpmc_stencil(BASIS);
-  double *restrict fb = g->fb;
+  double *restrict rec = g->node, *restrict fj = g->fbj;
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const mpmc_v2d vv = scatter_values(sim, DIM, q);
   MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
     const mpmc_v2d cv = wyz * vv;
-    double *restrict r = fb + row * 2;
-    for (int i = 0; i < S; ++i) MPMC_V2(r + 2 * i) += pw.w[i][0] * cv;
+    for (int i = 0; i < S; ++i) {
+      rec[(row + i) * MPMC_NREC + MPMC_VSLOT] += pw.w[i][0] * cv[0];
+      fj[row + i] += pw.w[i][0] * cv[1];
+    }
   });
 }
 
@@ -67,39 +74,38 @@ static inline double cbrt_near1(double r) {
   return r * y * y;
 }
 
-/* Point q's projected Jacobian pi: scale dF by (pi / (Jbar^n dJ))^(1/dim) (eq 27; the
+/* Point q's projected Jacobian pi: the factor (pi / (Jbar^n dJ))^(1/dim) of dF (eq 27; the
  * scatter left Jbar^n dJ in Jbar, inv = its reciprocal: taken by the callers before the
- * gather, the division runs beside it instead of after it), keep pi as Jbar. */
-MPMC_ALWAYS_INLINE void apply_projection(mpmc_particles *p, const int DIM, int q, double pi,
-                                         double inv) {
-  double *dF = p->dF + (size_t)q * DIM * DIM;
+ * gather, the division runs beside it instead of after it); keeps pi as Jbar. */
+MPMC_ALWAYS_INLINE double projection_scale(mpmc_particles *p, const int DIM, int q, double pi,
+                                           double inv) {
   const double r = pi * inv;
-  const double scale = DIM == 2 ? sqrt(r) : cbrt_near1(r);
-  for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
   p->Jbar[q] = pi;
+  return DIM == 2 ? sqrt(r) : cbrt_near1(r);
 }
 
 /* four doubles at p, unaligned, aliasing (the gather's row loads) */
 typedef double fb_v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
 
-/* Gather point q: Pi = sum w Jbar_i, scale dF (Algorithm 1, step 4).  Every row of the
- * stencil has the same x-weights, so Pi = sum_i wx_i (sum_rows wyz J_row+i): a row's nodes
- * are four contiguous doubles of fbj (those beyond the stencil unused), one
- * multiply-add per row, one dot product at the end. */
-MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
+/* Gather point q, at x^n = xs[q]: Pi = sum w Jbar_i (Algorithm 1, step 4); returns the
+ * factor of dF.  Every row of the stencil has the same x-weights, so
+ * Pi = sum_i wx_i (sum_rows wyz J_row+i): a row's nodes are four contiguous doubles of fbj
+ * (those beyond the stencil unused), one multiply-add per row, one dot product at the end. */
+MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BASIS,
+                                       const double *xs, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const int S = mpmc_stencil(BASIS);
   const double *restrict jb = g->fbj;
   const double inv = 1.0 / p->Jbar[q];
   mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
+  mpmc_point_weights(DIM, BASIS, g, xs + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   mpmc_b4d acc = {0.0, 0.0, 0.0, 0.0};
   MPMC_ROW_LOOP(DIM, BASIS, g, pw, { acc += wyz * *(const fb_v4u *)(jb + row); });
   double pi = 0.0;
   for (int i = 0; i < S; ++i) pi += pw.w[i][0] * acc[i];
-  apply_projection(p, DIM, q, pi, inv);
+  return projection_scale(p, DIM, q, pi, inv);
 }
 
 MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
@@ -112,16 +118,26 @@ MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const 
   MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
 }
 
-MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
+MPMC_ALWAYS_INLINE double gather_stable_scale(mpmc_sim sim, const int DIM, const int BASIS,
+                                              const double *xs, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double *restrict jb = g->fbj;
   const double inv = 1.0 / p->Jbar[q];
   mpmc_spw sp;
-  mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
+  mpmc_stable_weights(DIM, BASIS, g, xs + (size_t)q * DIM, &sp);
   double pi = 0.0;
   MPMC_STABLE_LOOP(DIM, BASIS, sp, { pi += w * jb[node]; });
-  apply_projection(p, DIM, q, pi, inv);
+  return projection_scale(p, DIM, q, pi, inv);
+}
+
+/* Gather point q in the form of the sim (STABLE: the stable one) and scale its dF. */
+MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, const int STABLE,
+                                     int q) {
+  const double scale = STABLE ? gather_stable_scale(sim, DIM, BASIS, sim->p.x, q)
+                              : gather_scale(sim, DIM, BASIS, sim->p.x, q);
+  double *dF = sim->p.dF + (size_t)q * DIM * DIM;
+  for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
 }
 
 /* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
@@ -136,7 +152,19 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
   }                                                                                          \
   static void gather_##D##_##B(mpmc_sim sim) {                                               \
     _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
-    for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, q);                           \
+    for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, 0, q);                        \
+  }                                                                                          \
+  /* the deferred gather of points q0 .. q1 - 1 of material id (x^n in xn by then) */        \
+  static void gather_range_##D##_##B(mpmc_sim sim, int id, int q0, int q1, double *scale) {  \
+    const int *restrict mat = sim->p.mat;                                                    \
+    const double *xs = sim->p.xn;                                                            \
+    if (sim->fbar == MPMC_FBAR_STABLE) {                                                     \
+      for (int q = q0; q < q1; ++q)                                                          \
+        if (mat[q] == id) scale[q - q0] = gather_stable_scale(sim, D, B, xs, q);             \
+    } else {                                                                                 \
+      for (int q = q0; q < q1; ++q)                                                          \
+        if (mat[q] == id) scale[q - q0] = gather_scale(sim, D, B, xs, q);                    \
+    }                                                                                        \
   }                                                                                          \
   /* the stable form's supports reach no further than the cubic B-spline's (nodes c - 1 ..  \
    * c + 2 of a point in cell c): the slabs keep same-coloured ones apart all the same */    \
@@ -151,16 +179,22 @@ MPMC_ALWAYS_INLINE void gather_stable_point(mpmc_sim sim, const int DIM, const i
   }                                                                                          \
   static void gather_stable_##D##_##B(mpmc_sim sim) {                                        \
     _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
-    for (int q = 0; q < sim->p.n; ++q) gather_stable_point(sim, D, B, q);                    \
+    for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, 1, q);                        \
   }
 MPMC_KERNELS(FBAR_KERNELS)
 
 /** Phase 4 of the step (only with F-bar on).  The nodes it touches: the active box, which
  * holds every point's support in every form (the cubic B-spline's reach, c - 1 .. c + 2, is
- * the widest; the stable form's spaces reach no further; t302 checks it). */
-int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
+ * the widest; the stable form's spaces reach no further; t302 checks it).
+ * defer: the step's call.  When every material's update runs the gather itself
+ * (ops->gathers_fbar: Hencky-J2), the gather is left to it (grid.fb_gather): each chunk of
+ * points is gathered where the update loads its dF, which then is read once and written
+ * never instead of read, scaled, written and read again (the landslide's points do not fit
+ * in the cache: a pass less over 311,250 of them).  Same bits either way. */
+int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   mpmc_grid *g = &sim->grid;
   const int stable = sim->fbar == MPMC_FBAR_STABLE;
+  for (int m = 0; m < sim->nmat && defer; ++m) defer = sim->mats[m].ops->gathers_fbar;
   if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
     mpmc_grid_clear_fb_active(g);
     if (stable)
@@ -169,18 +203,30 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
       MPMC_KERNEL_CALL(scatter_, sim, sim);
   }
   g->fb_done = 0;
-  /* nodal volume average (Algorithm 1 step 3) into fbj, row by row */
+  /* nodal volume average (Algorithm 1 step 3) into fbj, row by row: (V J)_i from fb's pairs
+   * (stable form) or fbj itself, V_i from fb or the records */
   const long nrow = mpmc_grid_active_rows(g);
   const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
-  const double *restrict fb = g->fb;
+  const double *restrict fb = g->fb, *restrict rec = g->node;
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
     const size_t first = mpmc_grid_active_row(g, r);
-    const double *f = fb + 2 * first;
     double *fj = g->fbj + first;
-    for (size_t i = 0; i < len; ++i) fj[i] = f[2 * i] > 0.0 ? f[2 * i + 1] / f[2 * i] : 0.0;
+    if (stable) {
+      const double *f = fb + 2 * first;
+      for (size_t i = 0; i < len; ++i) fj[i] = f[2 * i] > 0.0 ? f[2 * i + 1] / f[2 * i] : 0.0;
+    } else {
+      const double *v = rec + first * MPMC_NREC + MPMC_VSLOT;
+      for (size_t i = 0; i < len; ++i) {
+        const double vi = v[i * MPMC_NREC];
+        fj[i] = vi > 0.0 ? fj[i] / vi : 0.0;
+      }
+    }
   }
-  if (stable)
+  g->fb_gather = defer;
+  if (defer)
+    ; /* the material update gathers, from xn (mpmc_fbar_gather_range) */
+  else if (stable)
     MPMC_KERNEL_CALL(gather_stable_, sim, sim);
   else
     MPMC_KERNEL_CALL(gather_, sim, sim);
@@ -189,4 +235,11 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim) {
   sim->p.x = sim->p.xn;
   sim->p.xn = t;
   return MPMC_SUCCESS;
+}
+
+/* The deferred gather (grid.fb_gather) of material id's points among q0 .. q1 - 1: their
+ * projected Jacobians into Jbar, and into scale[q - q0] the factor of their dF (eq 27), which
+ * the caller applies as it loads dF; the other points' entries are left alone. */
+void MPMC_ISA(mpmc_fbar_gather_range)(mpmc_sim sim, int id, int q0, int q1, double *scale) {
+  MPMC_KERNEL_CALL(gather_range_, sim, sim, id, q0, q1, scale);
 }

@@ -59,7 +59,7 @@ static void set_active_all(mpmc_grid *g) {
 int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
   const size_t nn = g->nn;
   MPMC_CALL(alloc_d(ctx, &g->node, nn * MPMC_NREC));
-  if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fb, nn * 2));
+  if (with_fbar == MPMC_FBAR_STABLE) MPMC_CALL(alloc_d(ctx, &g->fb, nn * 2));
   if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fbj, nn + 4)); /* the gather reads 4 from a row start */
   if (!g->fixed) {
     g->fixed = calloc(nn, sizeof *g->fixed);
@@ -71,23 +71,28 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
 void mpmc_grid_clear(mpmc_grid *g, int with_fbar) {
   memset(g->node, 0, g->nn * MPMC_NREC * sizeof(double));
   if (with_fbar && g->fb) memset(g->fb, 0, g->nn * 2 * sizeof(double));
+  if (with_fbar && g->fbj) memset(g->fbj, 0, g->nn * sizeof(double));
   /* conservative: callers that clear by hand may then scatter anywhere */
   set_active_all(g);
   g->fb_done = 0;
 }
 
-/* Zero the active box's rows of node (when with_node) and of fb (when allocated), on all
- * threads: a serial memset of the landslide's box, ~12 MB, was half of the step's slab
- * phase on two threads. */
+/* Zero the active box's rows of node (when with_node, else only its MPMC_VSLOT), of fb and
+ * of fbj (when allocated), on all threads: a serial memset of the landslide's box, ~12 MB, was
+ * half of the step's slab phase on two threads. */
 static void clear_box(mpmc_grid *g, int with_node) {
   const long nrow = mpmc_grid_active_rows(g);
   const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
-  double *node = with_node ? g->node : NULL, *fb = g->fb;
+  double *node = g->node, *fb = g->fb, *fbj = g->fbj;
 #pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
     const size_t first = mpmc_grid_active_row(g, r);
-    if (node) memset(node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
+    if (with_node)
+      memset(node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
+    else
+      for (size_t i = first; i < first + len; ++i) node[i * MPMC_NREC + MPMC_VSLOT] = 0.0;
     if (fb) memset(fb + first * 2, 0, len * 2 * sizeof(double));
+    if (fbj) memset(fbj + first, 0, len * sizeof(double));
   }
 }
 

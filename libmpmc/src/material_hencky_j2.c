@@ -203,7 +203,7 @@ static double j2_wave_speed(const mpmc_material *m) {
   return sqrt((m->K + 4.0 / 3.0 * m->G) / m->rho);
 }
 
-const mpmc_material_ops mpmc_ops_hencky_j2 = {"hencky_j2", j2_update, j2_wave_speed};
+const mpmc_material_ops mpmc_ops_hencky_j2 = {"hencky_j2", j2_update, j2_wave_speed, 1, 1};
 
 /**
  * @brief Add Hencky-J2 with the strengths given as undrained shear strengths su.

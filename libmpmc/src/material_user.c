@@ -141,4 +141,4 @@ static int user_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt
 
 static double user_wave_speed(const mpmc_material *m) { return m->user_wave_speed; }
 
-const mpmc_material_ops mpmc_ops_user = {"user", user_update, user_wave_speed};
+const mpmc_material_ops mpmc_ops_user = {"user", user_update, user_wave_speed, 0, 0};

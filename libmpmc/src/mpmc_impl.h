@@ -2,6 +2,7 @@
 #ifndef MPMC_IMPL_H
 #define MPMC_IMPL_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -89,6 +90,12 @@ void mpmc_particles_free(mpmc_particles *p);
  * in whole vectors of 2 or 4 doubles: the halves are mass-momentum and force). */
 #define MPMC_NREC 8
 #define MPMC_FOFF 4
+/* Slot of F-bar's nodal volume sum w V^n (Algorithm 1 step 3) in the paper and total forms:
+ * P2G scatters it with the mass (the points are at x^n there as in the projection, and the
+ * slot rides in a vector P2G writes anyway), so G2P's fused scatter adds one value per node,
+ * V^n j, instead of two; the grid update leaves the slot alone. */
+#define MPMC_VSLOT 7
+_Static_assert(MPMC_VSLOT >= MPMC_FOFF + 3 && MPMC_VSLOT < MPMC_NREC, "a free record slot");
 typedef struct {
   int dim;
   double lo[3], hi[3]; /* user box                                                */
@@ -96,18 +103,24 @@ typedef struct {
   double origin[3];    /* position of node 0 (lo - GHOST*h)                        */
   int n[3];            /* nodes per axis (1 in unused axes)                         */
   size_t nn;           /* total nodes                                              */
-  double *node;        /* [nn][MPMC_NREC] mass, momentum, f_int + f_ext (slots above); after
-                          the grid update mass, new velocity, velocity increment         */
-  double *fb;          /* [nn][2] F-bar: sum w V, sum w V (Jbar dJ)                    */
-  double *fbj;         /* [nn + 4] F-bar: the nodal Jbar, their ratio, written in the active
-                          box (fbar.c); the gather loads rows of four from a row's first
-                          node, the lanes beyond the stencil unused                      */
+  double *node;        /* [nn][MPMC_NREC] mass, momentum, f_int + f_ext (slots above), with
+                          F-bar's paper and total forms sum w V^n in MPMC_VSLOT; after the
+                          grid update mass, new velocity, velocity increment            */
+  double *fb;          /* [nn][2] F-bar's stable form only: sum w V, sum w V J in its own
+                          space                                                           */
+  double *fbj;         /* [nn + 4] F-bar: the nodal Jbar in the active box (fbar.c); in the
+                          paper and total forms G2P scatters sum w V^n j here first, which
+                          the normalisation divides by MPMC_VSLOT's sum in place; the
+                          gather loads rows of four from a row's first node, the lanes
+                          beyond the stencil unused                                      */
   unsigned short *fixed; /* [nn] bit a: component a fixed; bit 3+a: v_a >= 0 only; bit 6+a: v_a <= 0 only */
   /* node index box [act_lo, act_hi) per axis outside which node and fb are zero: the points'
    * stencils of the last P2G (and the mirror partners the grid update folded into); P2G
    * clears only this box and the grid update visits only it */
   int act_lo[3], act_hi[3];
   int fb_done;         /* G2P scattered this step's F-bar volumes (fused, race-free)     */
+  int fb_gather;       /* the step's F-bar gather is left to the material update (every
+                          material's ops->gathers_fbar): it reads x^n from the points' xn */
   int *ccount;         /* p2g.c scratch: points per plane of cells, slab fill positions   */
   size_t cap_ccount;
   /* per-thread accumulation (p2g.c, private_grids) when slabs cannot keep the threads busy:
@@ -121,6 +134,7 @@ typedef struct {
 
 int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, const double *hi,
                     double h);
+/* with_fbar: the F-bar form (mpmc_fbar_mode; fb for the stable form alone) */
 int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar);
 /* zero the whole grid (with_fbar: the F-bar sums too) */
 void mpmc_grid_clear(mpmc_grid *g, int with_fbar);
@@ -129,7 +143,8 @@ void mpmc_grid_clear_active(mpmc_grid *g);
 double *mpmc_grid_copies(const mpmc_grid *g, double **buf, size_t *cap, int width, int ncopies);
 void mpmc_grid_add_copies(const mpmc_grid *g, double *dst, double *copies, int width,
                           int ncopies);
-/* zero the F-bar sums of the active box (the F-bar projection's nodes, in every form) */
+/* zero the F-bar sums of the active box (the F-bar projection's nodes, in every form): fb,
+ * fbj and the records' MPMC_VSLOT */
 void mpmc_grid_clear_fb_active(mpmc_grid *g);
 void mpmc_grid_free(mpmc_grid *g);
 /* The active box as rows of nodes along x: their number, and the first node of row r (each
@@ -169,6 +184,12 @@ typedef struct {
   int (*stress_update)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt);
   /* p-wave speed for the stable time step */
   double (*wave_speed)(const mpmc_material *mat);
+  /* 1: stress_update runs F-bar's gather for its points itself when the step defers it
+   * (grid.fb_gather; fbar.c mpmc_fbar_gather_range), scaling dF as it loads it */
+  int gathers_fbar;
+  /* 1: stress_update guards its stresses itself: the lowest index of a point it left with a
+   * non-finite stress into sim->stress_bad (stress_update.c) */
+  int checks_stress;
 } mpmc_material_ops;
 
 struct mpmc_material_s {
@@ -242,6 +263,7 @@ struct mpmc_sim_s {
   mpmc_particles p;
   mpmc_material *mats;
   int nmat, capmat;
+  int stress_bad; /* the step's stress guard: lowest point with a non-finite stress (INT_MAX) */
   mpmc_wall *walls;
   int nwall, capwall;
   int walls_dirty;    /* recompute the node constraint flags                           */
@@ -306,13 +328,18 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
   int mpmc_p2g##S(struct mpmc_sim_s *sim, double dt);          \
   int mpmc_grid_update##S(struct mpmc_sim_s *sim, double dt);  \
   int mpmc_g2p##S(struct mpmc_sim_s *sim, double dt);          \
-  int mpmc_fbar##S(struct mpmc_sim_s *sim);
+  int mpmc_fbar##S(struct mpmc_sim_s *sim, int defer);         \
+  void mpmc_fbar_gather_range##S(struct mpmc_sim_s *sim, int id, int q0, int q1, double *scale);
 /* phases of one step (step.c calls them in this order, mpmc_stress_update last) */
 MPMC_KERNEL_PROTOTYPES()
-#ifdef MPMC_HAVE_AVX2_KERNELS
+#if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2)
 MPMC_KERNEL_PROTOTYPES(_avx2)
 #endif
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
+/* the step's stress guard (stress_update.c): 0 if a component of s (Voigt) is NaN or Inf */
+static inline int mpmc_stress_finite(const double *s) {
+  return isfinite(s[0] + s[1] + s[2] + s[3] + s[4] + s[5]);
+}
 /* 1 if this build carries the AVX2 kernels and the processor (and OS) runs them (sim.c) */
 int mpmc_kernels_avx2_available(void);
 

@@ -170,19 +170,23 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   return MPMC_SUCCESS;
 }
 
-/* Value of record slot s for mass m, momentum mv and force f (vectors of DIM); with DIM and s
- * constants this folds to one of them. */
+/* Value of record slot s for mass m, momentum mv, force f (vectors of DIM) and F-bar's volume
+ * vol; with DIM and s constants this folds to one of them. */
 MPMC_ALWAYS_INLINE double rec_slot(const int DIM, int s, double m, const double *mv,
-                                   const double *f) {
+                                   const double *f, double vol) {
   return s == 0                               ? m
          : s <= DIM                           ? mv[s - 1]
          : s >= MPMC_FOFF && s < MPMC_FOFF + DIM ? f[s - MPMC_FOFF]
+         : s == MPMC_VSLOT                    ? vol
                                               : 0.0;
 }
 
 /* Scatter point q: mass, momentum and force w m, w m v, -V sigma grad w + w f_ext, all
- * into the node records.  Per row of the stencil the record's increment splits as
- *   rec += w_x c + w_x' e,  c = wyz (m, m v, f_ext) + dyz (-V sigma_.1) + ydz (-V sigma_.2),
+ * into the node records, and with F-bar's paper and total forms the volume w V^n into
+ * MPMC_VSLOT (Algorithm 1 step 3's nodal volume: the same products w_x (wyz V) as G2P's scatter
+ * of V^n j, the other terms adding exact zeros to the slot).
+ * Per row of the stencil the record's increment splits as
+ *   rec += w_x c + w_x' e,  c = wyz (m, m v, f_ext, V) + dyz (-V sigma_.1) + ydz (-V sigma_.2),
  *                           e = wyz (-V sigma_.0)
  * (grad w = (w_x' wyz, w_x dyz, w_x ydz)), with c and e fixed along the row: per node a few
  * whole-vector multiply-adds on one record. */
@@ -196,6 +200,7 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
   mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const double m = p->m[q];
   const double V = p->vol0[q] * p->J[q];
+  const double vf = sim->fbar == MPMC_FBAR_PAPER || sim->fbar == MPMC_FBAR_TOTAL ? V : 0.0;
   const double *s = p->stress + (size_t)q * 6;
   /* -V sigma, rows of the (symmetric) stress in the dim-dimensional subspace; being
    * symmetric, row b is also column b */
@@ -215,10 +220,10 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
   /* record-shaped factors (m, m v | f_ext) and (0, 0 | -V sigma_.b), built in registers (a
    * round trip through memory would stall on store forwarding) */
   static const double zero3[3] = {0, 0, 0};
-#define MF_(sl) rec_slot(DIM, sl, m, mv, fe)
-#define S0_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[0])
-#define S1_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[1])
-#define S2_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[2])
+#define MF_(sl) rec_slot(DIM, sl, m, mv, fe, vf)
+#define S0_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[0], 0.0)
+#define S1_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[1], 0.0)
+#define S2_(sl) rec_slot(DIM, sl, 0.0, zero3, vs[2], 0.0)
   mpmc_vd MF[MPMC_NV], S0[MPMC_NV], S1[MPMC_NV], S2[MPMC_NV];
   for (int k = 0; k < NV; ++k) {
     MF[k] = MPMC_VSET(MF_, k);

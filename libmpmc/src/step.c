@@ -19,7 +19,7 @@ typedef struct {
   int (*p2g)(mpmc_sim, double);
   int (*grid_update)(mpmc_sim, double);
   int (*g2p)(mpmc_sim, double);
-  int (*fbar)(mpmc_sim);
+  int (*fbar)(mpmc_sim, int);
 } kernel_set;
 static const kernel_set baseline = {mpmc_slabs_build, mpmc_p2g, mpmc_grid_update, mpmc_g2p,
                                     mpmc_fbar};
@@ -60,8 +60,9 @@ static int step_phases(mpmc_sim sim, double dt, double *t) {
   PHASE(sim, MPMC_PHASE_P2G, t, k->p2g(sim, dt));     /* mass, momentum, forces   (eqs 7, 8, 10) */
   PHASE(sim, MPMC_PHASE_GRID, t, k->grid_update(sim, dt)); /* velocities, walls, damping (eq 9) */
   PHASE(sim, MPMC_PHASE_G2P, t, k->g2p(sim, dt));     /* v, dF, J, x              (eqs 13-17)    */
-  if (sim->fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim)); /* dF -> dF-bar (Alg. 1, 2-4) */
-  PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar) */
+  if (sim->fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim, 1)); /* dF -> dF-bar (Alg. 1, 2-4)   */
+  PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar);
+                                                 Hencky-J2 runs F-bar's gather itself */
   if (sim->bodies) MPMC_CALL(mpmc_contact_check(sim)); /* no point inside a rigid body */
   PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_monitor_step(sim)); /* NaN velocity, energy growth */
   return MPMC_SUCCESS;

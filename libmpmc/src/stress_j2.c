@@ -25,6 +25,7 @@
 #include "return_map.h"
 
 typedef double v4 __attribute__((vector_size(4 * sizeof(double))));
+#define J2_CHUNK 64 /* blocks of four points handed to a thread at a time */
 
 /* c = a b for symmetric a, b (Voigt) that commute, as mpmc_sym3_mul */
 static inline void sym_mul4(const v4 *a, const v4 *b, v4 *c) {
@@ -172,10 +173,12 @@ static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, c
 }
 
 /**
- * Update the stress of every point of material id (F-bar scaled dF in p->dF): elastic
- * points in blocks of four, the others by the scalar return map.  *nret and *nfb count the
- * plastic corrections and KINSOL fallbacks; *first_bad is the lowest failed point (INT_MAX
- * for none), left unchanged for material_hencky_j2.c to report.
+ * Update the stress of every point of material id (F-bar scaled dF in p->dF, or scaled here
+ * when the step deferred F-bar's gather): elastic points in blocks of four, the others by the
+ * scalar return map.  *nret and *nfb count the plastic corrections and KINSOL fallbacks;
+ * *first_bad is the lowest failed point (INT_MAX for none), left unchanged for
+ * material_hencky_j2.c to report; the lowest point left with a non-finite stress goes into
+ * sim->stress_bad (stress_update.c's guard).
  */
 int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                             mpmc_rm_ws **ws, int64_t *nret_out, int64_t *nfb_out,
@@ -184,12 +187,13 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
   const int d = sim->dim, solver = sim->solver, n = p->n;
   const mpmc_j2_param par = {mat->K, mat->G, mat->kappa_p, mat->kappa_r, mat->eta};
   const double G2 = 2.0 * par.G, K = par.K;
-  const int nblk = (n + 3) / 4;
+  const int nblk = (n + 3) / 4, nchunk = (nblk + J2_CHUNK - 1) / J2_CHUNK;
+  const int gather = sim->grid.fb_gather;
   int64_t nret = 0, nfb = 0;
-  int first_bad = INT_MAX;
+  int first_bad = INT_MAX, first_nf = INT_MAX; /* failed return map; non-finite stress */
   /* threads only pay off beyond a few hundred points (a parallel region costs ~us, far
      more when the cores are shared) */
-#pragma omp parallel if (n >= 256) reduction(+ : nret, nfb) reduction(min : first_bad)
+#pragma omp parallel if (n >= 256) reduction(+ : nret, nfb) reduction(min : first_bad, first_nf)
   {
     int tid = 0;
 #ifdef _OPENMP
@@ -197,127 +201,143 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
 #endif
     mpmc_rm_ws *w = ws[tid];
     /* dynamic: plastic points cost several elastic ones and gather where the soil fails,
-     * which after a sort by cell is one stretch of the index range */
-#pragma omp for schedule(dynamic, 64)
-    for (int blk = 0; blk < nblk; ++blk) {
-      const int q0 = 4 * blk;
-      int act[4], nact = 0;
-      v4 F[9], b[6];
-      for (int l = 0; l < 4; ++l) {
-        const int q = q0 + l;
-        act[l] = q < n && p->mat[q] == id;
-        nact += act[l];
-        if (act[l]) {
-          const double *f = p->dF + (size_t)q * d * d, *be = p->be + (size_t)q * 6;
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) F[3 * i + j][l] = (i < d && j < d) ? f[i * d + j] : (i == j);
-          for (int k = 0; k < 6; ++k) b[k][l] = be[k];
-        } else { /* identity: a finite, elastic dummy */
-          for (int k = 0; k < 9; ++k) F[k][l] = (k % 4 == 0);
-          for (int k = 0; k < 6; ++k) b[k][l] = k < 3;
-        }
-      }
-      if (!nact) continue;
-      /* trial b = F b_e F^T (mpmc_push_forward's order): T = F B, then T F^T's upper half */
-      const v4 B[3][3] = {{b[0], b[5], b[4]}, {b[5], b[1], b[3]}, {b[4], b[3], b[2]}};
-      v4 T[3][3];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          T[i][j] = F[3 * i] * B[0][j] + F[3 * i + 1] * B[1][j] + F[3 * i + 2] * B[2][j];
-      v4 bt[6];
-      static const int vi[6] = {0, 1, 2, 1, 0, 0}, vj[6] = {0, 1, 2, 2, 2, 1};
-      for (int k = 0; k < 6; ++k) {
-        const int i = vi[k], j = vj[k];
-        bt[k] = T[i][0] * F[3 * j] + T[i][1] * F[3 * j + 1] + T[i][2] * F[3 * j + 2];
-      }
-      v4 eps[6], e[6];
-      int fail[4];
-      log_series4(bt, act, eps, fail);
-      const v4 tr = eps[0] + eps[1] + eps[2];
-      for (int k = 0; k < 6; ++k) e[k] = eps[k];
-      for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
-      v4 q2;
-      norm2_4(e, &q2);
-      q2 *= 1.5;
-      /* J = sqrt(det b) = exp(tr eps), without the exp */
-      const v4 detb = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
-                      bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
-      /* elastic lanes finish here (the rest: todo); with the auto solver the plastic ones go
-       * on together (plastic4, pl), the others and any plastic4 hands back one by one */
-      int todo[4] = {0, 0, 0, 0}, pl[4] = {0, 0, 0, 0}, npl = 0;
-      v4 k0v, qtrv;
-      for (int l = 0; l < 4; ++l) {
-        k0v[l] = qtrv[l] = 1.0; /* finite dummies for plastic4's unused lanes */
-        if (!act[l]) continue;
-        const int q = q0 + l;
-        const double k0 = mpmc_j2_kappa(&par, p->eps_p[q]);
-        const double qtr = sqrt(q2[l]) * G2;
-        double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
-        if (!fail[l] && isfinite(qtr) && detb[l] > 0.0 && qtr <= k0) {
-          /* elastic: b_e = trial b */
-          const double inv_J = 1.0 / sqrt(detb[l]);
-          for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
-          for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
-          continue;
-        }
-        k0v[l] = k0, qtrv[l] = qtr;
-        todo[l] = 1;
-        pl[l] = solver == MPMC_SOLVER_AUTO && !fail[l] && isfinite(qtr) && detb[l] > 0.0;
-        npl += pl[l];
-      }
-      if (npl) {
-        v4 dg, bn[6], es[6];
-        plastic4(&par, bt, e, &qtrv, &k0v, pl, &dg, bn, es);
+     * which after a sort by cell is one stretch of the index range.  Chunks of J2_CHUNK
+     * blocks; with F-bar's gather deferred to here (grid.fb_gather, fbar.c) each chunk's
+     * points are gathered first, their dF-bar = scale dF formed as dF is loaded. */
+#pragma omp for schedule(dynamic, 1)
+    for (int ch = 0; ch < nchunk; ++ch) {
+      const int b0 = ch * J2_CHUNK, b1 = b0 + J2_CHUNK < nblk ? b0 + J2_CHUNK : nblk;
+      const int c0 = 4 * b0, c1 = 4 * b1 < n ? 4 * b1 : n;
+      double scale[4 * J2_CHUNK];
+      if (gather) MPMC_ISA(mpmc_fbar_gather_range)(sim, id, c0, c1, scale);
+      for (int blk = b0; blk < b1; ++blk) {
+        const int q0 = 4 * blk;
+        int act[4], nact = 0;
+        v4 F[9], b[6];
         for (int l = 0; l < 4; ++l) {
-          if (!pl[l]) continue; /* not plastic4's, or handed back */
           const int q = q0 + l;
-          double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
-          for (int k = 0; k < 6; ++k) be[k] = bn[k][l];
-          p->eps_p[q] += dg[l];
-          /* tau as mpmc_j2_plastic's (series_tau), sigma = tau / J, J = sqrt(det b) */
-          const double inv_J = 1.0 / sqrt(detb[l]);
-          for (int k = 0; k < 6; ++k) {
-            double t = G2 * es[k][l];
-            if (k < 3) t += K * tr[l];
-            sg[k] = t * inv_J;
+          act[l] = q < n && p->mat[q] == id;
+          nact += act[l];
+          if (act[l]) {
+            const double *f = p->dF + (size_t)q * d * d, *be = p->be + (size_t)q * 6;
+            const double sc = gather ? scale[q - c0] : 1.0; /* dF-bar = sc dF */
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j)
+                F[3 * i + j][l] = (i < d && j < d) ? f[i * d + j] * sc : (i == j);
+            for (int k = 0; k < 6; ++k) b[k][l] = be[k];
+          } else { /* identity: a finite, elastic dummy */
+            for (int k = 0; k < 9; ++k) F[k][l] = (k % 4 == 0);
+            for (int k = 0; k < 6; ++k) b[k][l] = k < 3;
           }
-          ++nret;
         }
-      }
-      for (int l = 0; l < 4; ++l) {
-        if (!todo[l] || pl[l]) continue;
-        const int q = q0 + l;
-        double *ep = p->eps_p + q;
-        const double k0 = k0v[l], qtr = qtrv[l];
-        double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
-        double tau[6], J;
-        mpmc_j2_info info = {0};
-        int err;
-        if (!fail[l] && isfinite(qtr) && detb[l] > 0.0) {
-          /* plastic: the scalar solve and b_e from this trial state */
-          double bl[6], el[6];
-          for (int k = 0; k < 6; ++k) bl[k] = bt[k][l], el[k] = e[k][l];
-          err = mpmc_j2_plastic(w, solver, &par, bl, el, tr[l], qtr, k0, be, ep, tau, NULL, &info);
-          J = sqrt(detb[l]); /* = exp(tr eps): the flow is isochoric */
-        } else { /* outside the series or not finite: the scalar map from b_e^n and dF */
-          double Fl[3][3];
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) Fl[i][j] = F[3 * i + j][l];
-          err = mpmc_j2_return_map(w, solver, &par, Fl, be, ep, tau, &J, &info);
+        if (!nact) continue;
+        /* trial b = F b_e F^T (mpmc_push_forward's order): T = F B, then T F^T's upper half */
+        const v4 B[3][3] = {{b[0], b[5], b[4]}, {b[5], b[1], b[3]}, {b[4], b[3], b[2]}};
+        v4 T[3][3];
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            T[i][j] = F[3 * i] * B[0][j] + F[3 * i + 1] * B[1][j] + F[3 * i + 2] * B[2][j];
+        v4 bt[6];
+        static const int vi[6] = {0, 1, 2, 1, 0, 0}, vj[6] = {0, 1, 2, 2, 2, 1};
+        for (int k = 0; k < 6; ++k) {
+          const int i = vi[k], j = vj[k];
+          bt[k] = T[i][0] * F[3 * j] + T[i][1] * F[3 * j + 1] + T[i][2] * F[3 * j + 2];
         }
-        if (err) {
-          if (q < first_bad) first_bad = q;
-          continue;
+        v4 eps[6], e[6];
+        int fail[4];
+        log_series4(bt, act, eps, fail);
+        const v4 tr = eps[0] + eps[1] + eps[2];
+        for (int k = 0; k < 6; ++k) e[k] = eps[k];
+        for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
+        v4 q2;
+        norm2_4(e, &q2);
+        q2 *= 1.5;
+        /* J = sqrt(det b) = exp(tr eps), without the exp */
+        const v4 detb = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
+                        bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
+        /* elastic lanes finish here (the rest: todo); with the auto solver the plastic ones go
+         * on together (plastic4, pl), the others and any plastic4 hands back one by one */
+        int todo[4] = {0, 0, 0, 0}, pl[4] = {0, 0, 0, 0}, npl = 0;
+        v4 k0v, qtrv;
+        for (int l = 0; l < 4; ++l) {
+          k0v[l] = qtrv[l] = 1.0; /* finite dummies for plastic4's unused lanes */
+          if (!act[l]) continue;
+          const int q = q0 + l;
+          const double k0 = mpmc_j2_kappa(&par, p->eps_p[q]);
+          const double qtr = sqrt(q2[l]) * G2;
+          double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
+          if (!fail[l] && isfinite(qtr) && detb[l] > 0.0 && qtr <= k0) {
+            /* elastic: b_e = trial b */
+            const double inv_J = 1.0 / sqrt(detb[l]);
+            for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
+            for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
+            if (!mpmc_stress_finite(sg) && q < first_nf) first_nf = q;
+            continue;
+          }
+          k0v[l] = k0, qtrv[l] = qtr;
+          todo[l] = 1;
+          pl[l] = solver == MPMC_SOLVER_AUTO && !fail[l] && isfinite(qtr) && detb[l] > 0.0;
+          npl += pl[l];
         }
-        nret += info.plastic;
-        nfb += info.fallback;
-        const double inv_J = 1.0 / J;
-        for (int k = 0; k < 6; ++k) sg[k] = tau[k] * inv_J;
+        if (npl) {
+          v4 dg, bn[6], es[6];
+          plastic4(&par, bt, e, &qtrv, &k0v, pl, &dg, bn, es);
+          for (int l = 0; l < 4; ++l) {
+            if (!pl[l]) continue; /* not plastic4's, or handed back */
+            const int q = q0 + l;
+            double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
+            for (int k = 0; k < 6; ++k) be[k] = bn[k][l];
+            p->eps_p[q] += dg[l];
+            /* tau as mpmc_j2_plastic's (series_tau), sigma = tau / J, J = sqrt(det b) */
+            const double inv_J = 1.0 / sqrt(detb[l]);
+            for (int k = 0; k < 6; ++k) {
+              double t = G2 * es[k][l];
+              if (k < 3) t += K * tr[l];
+              sg[k] = t * inv_J;
+            }
+            if (!mpmc_stress_finite(sg) && q < first_nf) first_nf = q;
+            ++nret;
+          }
+        }
+        for (int l = 0; l < 4; ++l) {
+          if (!todo[l] || pl[l]) continue;
+          const int q = q0 + l;
+          double *ep = p->eps_p + q;
+          const double k0 = k0v[l], qtr = qtrv[l];
+          double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
+          double tau[6], J;
+          mpmc_j2_info info = {0};
+          int err;
+          if (!fail[l] && isfinite(qtr) && detb[l] > 0.0) {
+            /* plastic: the scalar solve and b_e from this trial state */
+            double bl[6], el[6];
+            for (int k = 0; k < 6; ++k) bl[k] = bt[k][l], el[k] = e[k][l];
+            err = mpmc_j2_plastic(w, solver, &par, bl, el, tr[l], qtr, k0, be, ep, tau, NULL, &info);
+            J = sqrt(detb[l]); /* = exp(tr eps): the flow is isochoric */
+          } else { /* outside the series or not finite: the scalar map from b_e^n and dF */
+            double Fl[3][3];
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j) Fl[i][j] = F[3 * i + j][l];
+            err = mpmc_j2_return_map(w, solver, &par, Fl, be, ep, tau, &J, &info);
+          }
+          if (err) {
+            if (q < first_bad) first_bad = q;
+            if (gather) /* the report (material_hencky_j2.c) repeats it from dF-bar */
+              for (int k = 0; k < d * d; ++k) p->dF[(size_t)q * d * d + k] = F[3 * (k / d) + k % d][l];
+            continue;
+          }
+          nret += info.plastic;
+          nfb += info.fallback;
+          const double inv_J = 1.0 / J;
+          for (int k = 0; k < 6; ++k) sg[k] = tau[k] * inv_J;
+          if (!mpmc_stress_finite(sg) && q < first_nf) first_nf = q;
+        }
       }
     }
   }
   *nret_out = nret;
   *nfb_out = nfb;
   *first_bad_out = first_bad;
+  if (first_nf < sim->stress_bad) sim->stress_bad = first_nf; /* stress_update.c's guard */
   return MPMC_SUCCESS;
 }

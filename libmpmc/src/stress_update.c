@@ -1,5 +1,6 @@
-/* Stress update: each material updates its points from dF (dF-bar with F-bar on), batched
- * over the particle arrays; then the step's guard against NaN/Inf stress. */
+/* Stress update: each material updates its points from dF (dF-bar with F-bar on, which
+ * Hencky-J2 forms itself when the step left F-bar's gather to it: fbar.c), batched over the
+ * particle arrays; then the step's guard against NaN/Inf stress. */
 #include <limits.h>
 #include <math.h>
 
@@ -7,15 +8,22 @@
 
 /** Phase 5 of the step. */
 int mpmc_stress_update(mpmc_sim sim, double dt) {
-  for (int m = 0; m < sim->nmat; ++m)
-    MPMC_CALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, dt));
+  int err = MPMC_SUCCESS, guarded = 1;
+  sim->stress_bad = INT_MAX;
+  for (int m = 0; m < sim->nmat && !err; ++m) {
+    err = sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, dt);
+    guarded &= sim->mats[m].ops->checks_stress;
+  }
+  sim->grid.fb_gather = 0; /* the materials ran F-bar's gather if the step left it to them */
+  if (err) return err;
   const mpmc_particles *p = &sim->p;
-  int first_bad = INT_MAX;
+  /* the guard: in the materials' own loops where they all keep it (Hencky-J2: a pass over
+   * the stresses less), else here */
+  int first_bad = sim->stress_bad;
+  if (!guarded) {
 #pragma omp parallel for schedule(static) reduction(min : first_bad) if (p->n > MPMC_OMP_MIN)
-  for (int q = 0; q < p->n; ++q) {
-    const double *s = p->stress + (size_t)q * 6;
-    const double sum = s[0] + s[1] + s[2] + s[3] + s[4] + s[5];
-    if (!isfinite(sum) && q < first_bad) first_bad = q;
+    for (int q = 0; q < p->n; ++q)
+      if (!mpmc_stress_finite(p->stress + (size_t)q * 6) && q < first_bad) first_bad = q;
   }
   if (first_bad != INT_MAX) {
     const int q = first_bad, d = sim->dim;
