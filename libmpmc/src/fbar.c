@@ -84,9 +84,6 @@ MPMC_ALWAYS_INLINE double projection_scale(mpmc_particles *p, const int DIM, int
   return DIM == 2 ? sqrt(r) : cbrt_near1(r);
 }
 
-/* four doubles at p, unaligned, aliasing (the gather's row loads) */
-typedef double fb_v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
-
 /* Gather point q, at x^n = xs[q]: Pi = sum w Jbar_i (Algorithm 1, step 4); returns the
  * factor of dF.  Every row of the stencil has the same x-weights, so
  * Pi = sum_i wx_i (sum_rows wyz J_row+i): a row's nodes are four contiguous doubles of fbj
@@ -102,7 +99,7 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
   mpmc_point_weights(DIM, BASIS, g, xs + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   mpmc_b4d acc = {0.0, 0.0, 0.0, 0.0};
-  MPMC_ROW_LOOP(DIM, BASIS, g, pw, { acc += wyz * *(const fb_v4u *)(jb + row); });
+  MPMC_ROW_LOOP(DIM, BASIS, g, pw, { acc += wyz * *(const mpmc_b4du *)(jb + row); });
   double pi = 0.0;
   for (int i = 0; i < S; ++i) pi += pw.w[i][0] * acc[i];
   return projection_scale(p, DIM, q, pi, inv);

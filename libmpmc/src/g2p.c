@@ -18,9 +18,6 @@ typedef struct {
                              the nodes there); further out the support leaves the grid   */
 } g2p_ctx;
 
-/* four doubles at p, unaligned, aliasing */
-typedef double g2p_v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
-
 /* F-bar's scatter along a stencil row: f[i] += w_x,i cv, i < S, as whole vectors (the lanes'
  * products and sums are the scalar ones).  Three nodes: AVX2's masked load and store, which
  * leave the fourth node alone (it may be another slab's), else two plus one.  Against three
@@ -30,7 +27,7 @@ MPMC_ALWAYS_INLINE void fb_row(const int S, double *restrict f, const mpmc_pw *p
   if (S == 2) {
     MPMC_V2(f) += (mpmc_v2d){W_(0), W_(1)} * cv;
   } else if (S == 4) {
-    *(g2p_v4u *)f += (mpmc_b4d){W_(0), W_(1), W_(2), W_(3)} * cv;
+    *(mpmc_b4du *)f += (mpmc_b4d){W_(0), W_(1), W_(2), W_(3)} * cv;
   } else {
 #if defined(__AVX2__)
     const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);

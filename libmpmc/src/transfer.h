@@ -62,6 +62,8 @@ typedef double mpmc_v2d __attribute__((vector_size(2 * sizeof(double))));
 typedef double mpmc_vdu
     __attribute__((vector_size(MPMC_VW * sizeof(double)), aligned(8), may_alias));
 typedef double mpmc_v2du __attribute__((vector_size(2 * sizeof(double)), aligned(8), may_alias));
+/* four doubles at any double's address, aliasing (rows of a stencil's scalar node values) */
+typedef double mpmc_b4du __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
 #define MPMC_V(p) (*(mpmc_vdu *)(p))
 #define MPMC_VC(p) (*(const mpmc_vdu *)(p))
 #define MPMC_V2(p) (*(mpmc_v2du *)(p))
