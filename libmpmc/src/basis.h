@@ -30,7 +30,8 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
  * the B-splines and the linear basis the scalar form per axis was the faster).
  * s = (x_p - origin)/h per lane; l = half-length / h (all axes).  Writes the first stencil
  * node per lane into base, and w[k], dw[k] (d/dx_p, per metre) of the k-th node of each
- * axis's stencil, k < MPMC_MAX_STENCIL (0 for the fourth).
+ * axis's stencil, k < MPMC_MAX_STENCIL (0 for the fourth); dw may be a constant NULL (the
+ * weights alone).  w and dw are 32-byte aligned tables (mpmc_pw's), stored into directly.
  *
  * uGIMP (0 < l <= 1/2): the hat N(x) = max(0, 1 - |x|) averaged over the point,
  * w = (1/2l) int_{x-l}^{x+l} N, with y the point's offset from the middle node of its three
@@ -47,6 +48,8 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
 typedef double mpmc_b4d __attribute__((vector_size(4 * sizeof(double))));
 typedef long long mpmc_b4l __attribute__((vector_size(4 * sizeof(long long))));
 typedef int mpmc_b4i __attribute__((vector_size(4 * sizeof(int))));
+/* the same as mpmc_b4d in memory that is also read as doubles (the weight tables) */
+typedef double mpmc_b4da __attribute__((vector_size(4 * sizeof(double)), may_alias));
 
 /* floor per lane as doubles (|s| < 2^31), its int in *bi: truncation corrected below zero
  * (vectors through pointers: by value they would change the baseline build's ABI) */
@@ -59,7 +62,7 @@ MPMC_ALWAYS_INLINE void mpmc_floor4(const mpmc_b4d *s, mpmc_b4i *bi, mpmc_b4d *f
 }
 
 MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, double l, double inv_h, mpmc_b4i *base,
-                                        mpmc_b4d *w, mpmc_b4d *dw) {
+                                        mpmc_b4da *w, mpmc_b4da *dw) {
   const mpmc_b4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0}, s = *sp;
   mpmc_b4d fl;
   const mpmc_b4d sh = s - 0.5;
@@ -76,11 +79,14 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, double l, double inv
   w[0] = a * a * i4l + SEL4_(t0 > zero, t0, zero);
   w[1] = one - (c * c + l * l) * i2l - d;
   w[2] = e * e * i4l + SEL4_(t2 > zero, t2, zero);
+  w[3] = zero;
 #undef SEL4_
-  dw[0] = (zero - a) * gl;
-  dw[1] = -2.0 * c * gl;
-  dw[2] = e * gl;
-  w[3] = dw[3] = zero;
+  if (dw) {
+    dw[0] = (zero - a) * gl;
+    dw[1] = -2.0 * c * gl;
+    dw[2] = e * gl;
+    dw[3] = zero;
+  }
 }
 
 /* Weights w[k] and gradients dw[k] (d/dx_p, per metre) of nodes base..base+S-1 along one
@@ -129,7 +135,7 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
     }
     default: { /* MPMC_BASIS_UGIMP: one lane of mpmc_ugimp_axes, and the fourth node (0), as
                   its callers' arrays are that long */
-      mpmc_b4d wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL];
+      mpmc_b4da wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL];
       mpmc_b4i b;
       const mpmc_b4d sv = {s, s, s, s};
       mpmc_ugimp_axes(&sv, l, inv_h, &b, wv, dv);

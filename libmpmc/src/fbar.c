@@ -44,7 +44,7 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   const int S = mpmc_stencil(BASIS);
   double *restrict rec = g->node, *restrict fj = g->fbj;
   mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, g, p->x + (size_t)q * DIM,
+  mpmc_point_weights(DIM, BASIS, 0, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const mpmc_v2d vv = scatter_values(sim, DIM, q);
   MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
@@ -96,7 +96,7 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
   const double *restrict jb = g->fbj;
   const double inv = 1.0 / p->Jbar[q];
   mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, g, xs + (size_t)q * DIM,
+  mpmc_point_weights(DIM, BASIS, 0, g, xs + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   mpmc_b4d acc = {0.0, 0.0, 0.0, 0.0};
   MPMC_ROW_LOOP(DIM, BASIS, g, pw, { acc += wyz * *(const mpmc_b4du *)(jb + row); });

@@ -58,7 +58,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   const double *restrict rec = g->node;
   const size_t qd = (size_t)q * DIM;
   mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  mpmc_point_weights(DIM, BASIS, 1, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const mpmc_vd zero = {0.0}; /* the other lanes zero as well */
   /* With 2-wide vectors the whole record's sums and accumulators (16 vectors) overflow the
    * 16 SSE registers: the first sweep then takes the velocity half (v_pic, L) and the second

@@ -197,7 +197,7 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
   const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
   const size_t qd = (size_t)q * DIM;
   mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  mpmc_point_weights(DIM, BASIS, 1, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const double m = p->m[q];
   const double V = p->vol0[q] * p->J[q];
   const double vf = sim->fbar == MPMC_FBAR_PAPER || sim->fbar == MPMC_FBAR_TOTAL ? V : 0.0;
