@@ -28,7 +28,8 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
  * (x, y, z, and an unused fourth lane), the same arithmetic on every lane, so one evaluation
  * in vectors of four doubles (one AVX2 register, two SSE2 ones) serves the three axes (for
  * the B-splines and the linear basis the scalar form per axis was the faster).
- * s = (x_p - origin)/h per lane; l = half-length / h (all axes).  Writes the first stencil
+ * s = (x_p - origin)/h and l = half-length / h per lane (the lanes may also be four points
+ * along one axis: fbar.c's gather).  Writes the first stencil
  * node per lane into base, and w[k], dw[k] (d/dx_p, per metre) of the k-th node of each
  * axis's stencil, k < MPMC_MAX_STENCIL (0 for the fourth); dw may be a constant NULL (the
  * weights alone).  w and dw are 32-byte aligned tables (mpmc_pw's), stored into directly.
@@ -61,14 +62,14 @@ MPMC_ALWAYS_INLINE void mpmc_floor4(const mpmc_b4d *s, mpmc_b4i *bi, mpmc_b4d *f
   *fl = d - (mpmc_b4d)(below & (mpmc_b4l)(mpmc_b4d){1.0, 1.0, 1.0, 1.0});
 }
 
-MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, double l, double inv_h, mpmc_b4i *base,
-                                        mpmc_b4da *w, mpmc_b4da *dw) {
-  const mpmc_b4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0}, s = *sp;
+MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, double inv_h,
+                                        mpmc_b4i *base, mpmc_b4da *w, mpmc_b4da *dw) {
+  const mpmc_b4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0}, s = *sp, l = *lp;
   mpmc_b4d fl;
   const mpmc_b4d sh = s - 0.5;
   mpmc_floor4(&sh, base, &fl);
   const mpmc_b4d y = (s - fl) - 1.0;
-  const double i2l = 0.5 / l, i4l = 0.5 * i2l, gl = i2l * inv_h;
+  const mpmc_b4d i2l = 0.5 / l, i4l = 0.5 * i2l, gl = i2l * inv_h;
   const mpmc_b4d lo = zero - l, hi = zero + l;
 /* lanes of a where mask m is set, else of b */
 #define SEL4_(m, a, b) ((mpmc_b4d)(((m) & (mpmc_b4l)(a)) | (~(m) & (mpmc_b4l)(b))))
@@ -86,6 +87,38 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, double l, double inv
     dw[1] = -2.0 * c * gl;
     dw[2] = e * gl;
     dw[3] = zero;
+  }
+}
+
+/* The linear and B-spline weights in the lanes of s = (x_p - origin)/h (four points along
+ * one axis: fbar.c's gather), with mpmc_basis_1d's operations (the floor exact in either),
+ * hence its bits; no gradients. */
+MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, mpmc_b4i *base,
+                                        mpmc_b4da *w) {
+  const mpmc_b4d s = *sp;
+  mpmc_b4d fl;
+  if (basis == MPMC_BASIS_LINEAR) {
+    mpmc_floor4(&s, base, &fl);
+    const mpmc_b4d f = s - fl;
+    w[0] = 1.0 - f;
+    w[1] = f;
+  } else if (basis == MPMC_BASIS_BSPLINE2) {
+    const mpmc_b4d sh = s - 0.5;
+    mpmc_floor4(&sh, base, &fl);
+    const mpmc_b4d f = s - fl; /* in [0.5, 1.5) */
+    const mpmc_b4d x1 = f - 1.0;
+    w[0] = 0.5 * (1.5 - f) * (1.5 - f);
+    w[1] = 0.75 - x1 * x1;
+    w[2] = 0.5 * (f - 0.5) * (f - 0.5);
+  } else { /* cubic */
+    mpmc_floor4(&s, base, &fl);
+    *base -= 1;
+    const mpmc_b4d f = s - (fl - 1.0); /* in [1, 2) */
+    const mpmc_b4d x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
+    w[0] = x0 * x0 * x0 / 6.0;
+    w[1] = 0.5 * x1 * x1 * x1 - x1 * x1 + 2.0 / 3.0;
+    w[2] = 0.5 * x2 * x2 * x2 - x2 * x2 + 2.0 / 3.0;
+    w[3] = x3 * x3 * x3 / 6.0;
   }
 }
 
@@ -137,8 +170,8 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
                   its callers' arrays are that long */
       mpmc_b4da wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL];
       mpmc_b4i b;
-      const mpmc_b4d sv = {s, s, s, s};
-      mpmc_ugimp_axes(&sv, l, inv_h, &b, wv, dv);
+      const mpmc_b4d sv = {s, s, s, s}, lv = {l, l, l, l};
+      mpmc_ugimp_axes(&sv, &lv, inv_h, &b, wv, dv);
       *base = b[0];
       for (int k = 0; k < MPMC_MAX_STENCIL; ++k) {
         w[k] = wv[k][0];

@@ -18,27 +18,39 @@ typedef struct {
                              the nodes there); further out the support leaves the grid   */
 } g2p_ctx;
 
-/* F-bar's scatter along a stencil row: f[i] += w_x,i cv, i < S, as whole vectors (the lanes'
- * products and sums are the scalar ones).  Three nodes: AVX2's masked load and store, which
- * leave the fourth node alone (it may be another slab's), else two plus one.  Against three
- * scalar updates, 60 of G2P's 870 instructions a point less (B-spline2 and uGIMP, 3D). */
-MPMC_ALWAYS_INLINE void fb_row(const int S, double *restrict f, const mpmc_pw *pw, double cv) {
-#define W_(i) pw->w[i][0] /* node i's x-weight */
+/* F-bar's scatter along a stencil row: f[i] += v[i], i < S, as whole vectors (the lanes'
+ * sums are the scalar ones).  Three nodes: AVX2's masked load and store, which leave the
+ * fourth node alone (it may be another slab's), else two plus one. */
+MPMC_ALWAYS_INLINE void fb_row(const int S, double *restrict f, mpmc_b4d v) {
   if (S == 2) {
-    MPMC_V2(f) += (mpmc_v2d){W_(0), W_(1)} * cv;
+    MPMC_V2(f) += (mpmc_v2d){v[0], v[1]};
   } else if (S == 4) {
-    *(mpmc_b4du *)f += (mpmc_b4d){W_(0), W_(1), W_(2), W_(3)} * cv;
+    *(mpmc_b4du *)f += v;
   } else {
 #if defined(__AVX2__)
     const __m256i m3 = _mm256_set_epi64x(0, -1, -1, -1);
-    const __m256d add = _mm256_mul_pd(_mm256_set_pd(0.0, W_(2), W_(1), W_(0)), _mm256_set1_pd(cv));
-    _mm256_maskstore_pd(f, m3, _mm256_add_pd(_mm256_maskload_pd(f, m3), add));
+    _mm256_maskstore_pd(f, m3, _mm256_add_pd(_mm256_maskload_pd(f, m3), (__m256d)v));
 #else
-    MPMC_V2(f) += (mpmc_v2d){W_(0), W_(1)} * cv;
-    f[2] += W_(2) * cv;
+    MPMC_V2(f) += (mpmc_v2d){v[0], v[1]};
+    f[2] += v[2];
 #endif
   }
-#undef W_
+}
+
+/* Algorithm 1 step 3's scatter of V^n j (vj) into fbj with the weights pw:
+ * fbj_i += ((w_x vj) w_z) w_y, per plane of rows the x-weights times vj times w_z as one
+ * vector, then per row one vector multiply and add (fbar.c's scatter_point the same). */
+MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const mpmc_grid *g,
+                                   double *restrict fb, const mpmc_pw *pw, double vj) {
+  const int S = mpmc_stencil(BASIS);
+  const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
+  const mpmc_b4d wxv = (mpmc_b4d){pw->w[0][0], pw->w[1][0], S > 2 ? pw->w[2][0] : 0.0,
+                                  S > 3 ? pw->w[3][0] : 0.0} * vj;
+  for (int k = 0; k < (DIM == 3 ? S : 1); ++k) {
+    const mpmc_b4d wzv = DIM == 3 ? wxv * pw->w[k][2] : wxv;
+    double *f = fb + pw->node0 + sz * (size_t)k;
+    for (int j = 0; j < S; ++j) fb_row(S, f + sy * (size_t)j, wzv * pw->w[j][1]);
+  }
 }
 
 /* Gather point q; returns 0 if its volume inverted or it left the grid.  Per row of the
@@ -62,7 +74,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   const mpmc_vd zero = {0.0}; /* the other lanes zero as well */
   /* With 2-wide vectors the whole record's sums and accumulators (16 vectors) overflow the
    * 16 SSE registers: the first sweep then takes the velocity half (v_pic, L) and the second
-   * the increment half (dv), together with the fused F-bar scatter that needs dJ. */
+   * the increment half (dv).  The fused F-bar scatter, which needs dJ, has a loop of its own. */
   const int SPLIT = NC > 1, N1 = SPLIT ? NC : NV;
   mpmc_vd A[MPMC_NV], B0[MPMC_NC], B1[MPMC_NC], B2[MPMC_NC];
   for (int k = 0; k < NV; ++k) A[k] = zero;
@@ -113,18 +125,16 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     mpmc_stable_weights(DIM, BASIS, g, p->x + qd, &sp);
     MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
   }
-  if (SPLIT || FB == 1) {
+  if (FB == 1) fb_scatter(DIM, BASIS, g, fb, &pw, vj);
+  if (SPLIT) {
     MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
       mpmc_vd sw[MPMC_NV];
       for (int k = N1; k < NV; ++k) sw[k] = zero;
       const double *restrict r = rec + row * R;
-      double *restrict f = FB == 1 ? fb + row : NULL;
-      const double cv = wyz * vj;
       for (int i = 0; i < S; ++i) {
         const double wx = pw.w[i][0];
         for (int k = N1; k < NV; ++k) sw[k] += wx * MPMC_VC(r + i * R + MPMC_VW * k);
       }
-      if (FB == 1) fb_row(S, f, &pw, cv);
       for (int k = N1; k < NV; ++k) A[k] += wyz * sw[k];
     });
   }

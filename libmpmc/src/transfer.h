@@ -31,7 +31,9 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights(const int DIM, const int BASIS, const
     const mpmc_b4d o = {g->origin[0], g->origin[1], DIM == 3 ? g->origin[2] : 0.0, 0.0};
     const mpmc_b4d s = (xv - o) * g->inv_h;
     mpmc_b4i b;
-    mpmc_ugimp_axes(&s, lp * g->inv_h, g->inv_h, &b, (mpmc_b4da *)pw->w,
+    const double l = lp * g->inv_h;
+    const mpmc_b4d lv = {l, l, l, l};
+    mpmc_ugimp_axes(&s, &lv, g->inv_h, &b, (mpmc_b4da *)pw->w,
                     GRAD ? (mpmc_b4da *)pw->dw : NULL);
     for (int a = 0; a < DIM; ++a) base[a] = b[a];
   } else {
