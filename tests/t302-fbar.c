@@ -245,18 +245,28 @@ static void test_fb_cleared(void **state) {
  * material beside it brings back.  A 3D and a 2D block of softening J2 soil slumping under
  * gravity (plastic points, the return maps' chunks), every basis and form, 40 steps; the
  * deferred path leaves dF unscaled (it scales as it loads), so dF differs where F-bar acted. */
-static mpmc_sim slump(mpmc_context ctx, int dim, int basis, int form, int extra) {
+/* extra: an unused Hencky material too (no material update then gathers: the gather phase
+ * runs); two: the soil as two Hencky-J2 materials of the same parameters, split at x =
+ * 0.625 between the two points of a cell and sorted by cell, so that the deferred gather
+ * meets blocks of four points of both */
+static mpmc_sim slump(mpmc_context ctx, int dim, int basis, int form, int extra, int two) {
   mpmc_sim sim;
   TCALL(mpmc_sim_create(ctx, dim, &sim));
   const double lo[3] = {0, 0, 0}, hi[3] = {4, 2, 2};
   TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.25));
   TCALL(mpmc_sim_set_basis(sim, basis));
   TCALL(mpmc_sim_set_fbar(sim, form));
-  int mat, unused;
+  int mat, mat2 = -1, unused;
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e6, 0.45, 2000, 8e3, 2e3, 20, &mat));
+  if (two) TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e6, 0.45, 2000, 8e3, 2e3, 20, &mat2));
   if (extra) TCALL(mpmc_sim_add_material_hencky(sim, 1e6, 0.3, 2000, &unused));
-  const double blo[3] = {0, 0, 0}, bhi[3] = {1.5, 1.0, 1.5};
+  const double blo[3] = {0, 0, 0}, bhi[3] = {two ? 0.625 : 1.5, 1.0, 1.5};
   TCALL(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, NULL));
+  if (two) {
+    const double rlo[3] = {0.625, 0, 0}, rhi[3] = {1.5, 1.0, 1.5};
+    TCALL(mpmc_sim_seed_box(sim, rlo, rhi, 2, mat2, NULL, NULL));
+    TCALL(mpmc_sim_sort_particles(sim));
+  }
   const double g[3] = {0, dim == 2 ? -9.81 : 0, dim == 3 ? -9.81 : 0};
   TCALL(mpmc_sim_set_gravity(sim, g));
   for (int f = 0; f < 2 * dim; ++f) TCALL(mpmc_sim_add_wall_face(sim, f, MPMC_WALL_SLIP, NULL));
@@ -272,13 +282,14 @@ static void test_deferred_gather(void **state) {
   static const int fields[] = {MPMC_FIELD_POSITION, MPMC_FIELD_VELOCITY, MPMC_FIELD_J,
                                MPMC_FIELD_JBAR,     MPMC_FIELD_STRESS,   MPMC_FIELD_BE,
                                MPMC_FIELD_EPS_P};
+  for (int two = 0; two <= 1; ++two)
   for (int dim = 2; dim <= 3; ++dim)
     for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_STABLE; ++form)
       for (int b = 0; b < 4; ++b) {
         mpmc_context ctx;
         TCALL(mpmc_context_create(&ctx));
         test_ctx = ctx;
-        mpmc_sim fused = slump(ctx, dim, b, form, 0), apart = slump(ctx, dim, b, form, 1);
+        mpmc_sim fused = slump(ctx, dim, b, form, 0, two), apart = slump(ctx, dim, b, form, 1, two);
         const int n = fused->p.n;
         for (size_t f = 0; f < sizeof fields / sizeof fields[0]; ++f) {
           double *a, *c;
@@ -287,8 +298,8 @@ static void test_deferred_gather(void **state) {
           TCALL(mpmc_sim_get_field(apart, fields[f], &c, &nc));
           assert_int_equal(na, nc);
           if (memcmp(a, c, sizeof(double) * (size_t)na * (size_t)n) != 0)
-            fail_msg("dim %d form %d basis %d: field %d differs between the deferred gather and "
-                     "the gather phase", dim, form, b, fields[f]);
+            fail_msg("dim %d form %d basis %d (two materials: %d): field %d differs between the "
+                     "deferred gather and the gather phase", dim, form, b, two, fields[f]);
         }
         double plastic = 0.0, dfdiff = 0.0;
         for (int q = 0; q < n; ++q) plastic += fused->p.eps_p[q] > 0.0;

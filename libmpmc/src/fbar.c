@@ -22,6 +22,7 @@
  * Touches nothing but dF (handed to the material), Jbar, the grid's fb and fbj and the
  * records' MPMC_VSLOT. */
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "transfer.h"
@@ -153,18 +154,35 @@ MPMC_ALWAYS_INLINE void point_weights4(const int DIM, const int BASIS, const mpm
       mpmc_poly_lanes(BASIS, &s, &b[a], (mpmc_b4da *)t->w[a]);
     }
   }
-  for (int l = 0; l < 4; ++l)
-    t->node0[l] = (size_t)b[0][l] + (size_t)g->n[0] * ((size_t)b[1][l] + (size_t)g->n[1] * (size_t)b[2][l]);
+  /* the linear indices in doubles (exact: below 2^53), one conversion a point */
+  const mpmc_b4d nd = __builtin_convertvector(b[0], mpmc_b4d) +
+                      (double)g->n[0] * (__builtin_convertvector(b[1], mpmc_b4d) +
+                                         (double)g->n[1] * __builtin_convertvector(b[2], mpmc_b4d));
+  for (int l = 0; l < 4; ++l) t->node0[l] = (size_t)nd[l];
 }
 
-/* gather_scale for lane l of t, point q: the same sums in the same order */
-MPMC_ALWAYS_INLINE double gather_scale4(mpmc_sim sim, const int DIM, const int BASIS,
-                                        const pw4 *t, int l, int q) {
+/* gather_scale for the four points q .. q + 3 of t into scale[0..3], each lane with the
+ * same operations as one point alone (same bits): the reciprocals and the cube roots near 1
+ * as vectors, the rest lane by lane. */
+MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BASIS, const pw4 *t,
+                                      int q, double *scale) {
   mpmc_particles *p = &sim->p;
-  const double inv = 1.0 / p->Jbar[q];
-  const double pi = gather_rows(&sim->grid, DIM, BASIS, t->node0[l], &t->w[0][0][l],
-                                &t->w[1][0][l], &t->w[2][0][l], 4);
-  return projection_scale(p, DIM, q, pi, inv);
+  const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
+  mpmc_b4d pi;
+  for (int l = 0; l < 4; ++l)
+    pi[l] = gather_rows(&sim->grid, DIM, BASIS, t->node0[l], &t->w[0][0][l], &t->w[1][0][l],
+                        &t->w[2][0][l], 4);
+  *(mpmc_b4du *)(p->Jbar + q) = pi;
+  const mpmc_b4d r = pi * inv, e = r - 1.0;
+  const mpmc_b4l magn = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX}; /* all but the sign */
+  const mpmc_b4l small = (mpmc_b4d)((mpmc_b4l)e & magn) < 0.004;       /* |e| < 0.004, not NaN */
+  if (DIM == 3 && small[0] & small[1] & small[2] & small[3]) { /* cbrt_near1's first branch */
+    const mpmc_b4d e2 = e * e;
+    *(mpmc_b4du *)scale = (1.0 + e * (1.0 / 3.0)) +
+                          e2 * ((-1.0 / 9.0 + e * (5.0 / 81.0)) + e2 * (-10.0 / 243.0 + e * (22.0 / 729.0)));
+  } else {
+    for (int l = 0; l < 4; ++l) scale[l] = DIM == 2 ? sqrt(r[l]) : cbrt_near1(r[l]);
+  }
 }
 
 MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
@@ -222,13 +240,17 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
         if (mat[q] == id) scale[q - q0] = gather_stable_scale(sim, D, B, xs, q);             \
     } else { /* four points at a time, then the rest */                                     \
       int q = q0;                                                                            \
+      const int one = sim->nmat == 1; /* every point is id's */                             \
       for (; q + 4 <= q1; q += 4) {                                                          \
-        if (mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id)        \
+        if (!one && mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id) \
           continue;                                                                          \
         pw4 t;                                                                               \
         point_weights4(D, B, &sim->grid, &sim->p, xs, q, &t);                                \
-        for (int l = 0; l < 4; ++l)                                                          \
-          if (mat[q + l] == id) scale[q + l - q0] = gather_scale4(sim, D, B, &t, l, q + l);  \
+        if (one || (mat[q] == id && mat[q + 1] == id && mat[q + 2] == id && mat[q + 3] == id)) \
+          gather_scale4(sim, D, B, &t, q, scale + (q - q0));                                 \
+        else /* materials mixed: the others' scale and Jbar left alone */                    \
+          for (int l = 0; l < 4; ++l)                                                        \
+            if (mat[q + l] == id) scale[q + l - q0] = gather_scale(sim, D, B, xs, q + l);    \
       }                                                                                      \
       for (; q < q1; ++q)                                                                    \
         if (mat[q] == id) scale[q - q0] = gather_scale(sim, D, B, xs, q);                    \

@@ -19,12 +19,13 @@ typedef struct {
 } g2p_ctx;
 
 /* F-bar's scatter along a stencil row: f[i] += v[i], i < S, as whole vectors (the lanes'
- * sums are the scalar ones).  Three nodes: AVX2's masked load and store, which leave the
- * fourth node alone (it may be another slab's), else two plus one. */
-MPMC_ALWAYS_INLINE void fb_row(const int S, double *restrict f, mpmc_b4d v) {
+ * sums are the scalar ones).  Three nodes: with WIDE all four lanes (v[3] = 0 adds nothing
+ * to a node that no other thread writes meanwhile: fb_scatter), else AVX2's masked load and
+ * store, which leave the fourth node alone, else two plus one. */
+MPMC_ALWAYS_INLINE void fb_row(const int S, const int WIDE, double *restrict f, mpmc_b4d v) {
   if (S == 2) {
     MPMC_V2(f) += (mpmc_v2d){v[0], v[1]};
-  } else if (S == 4) {
+  } else if (S == 4 || WIDE) {
     *(mpmc_b4du *)f += v;
   } else {
 #if defined(__AVX2__)
@@ -39,9 +40,14 @@ MPMC_ALWAYS_INLINE void fb_row(const int S, double *restrict f, mpmc_b4d v) {
 
 /* Algorithm 1 step 3's scatter of V^n j (vj) into fbj with the weights pw:
  * fbj_i += ((w_x vj) w_z) w_y, per plane of rows the x-weights times vj times w_z as one
- * vector, then per row one vector multiply and add (fbar.c's scatter_point the same). */
-MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const mpmc_grid *g,
-                                   double *restrict fb, const mpmc_pw *pw, double vj) {
+ * vector, then per row one vector multiply and add (fbar.c's scatter_point the same).
+ * WIDE: rows of three nodes as four (the fourth plus 0), where the node after a row is
+ * written by this thread alone: each thread into its own copy of fbj, or slabs across y or
+ * z, as the row then lies in this slab's planes, which no point of a slab of the same colour
+ * reaches (fbj has four nodes to spare at its end). */
+MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WIDE,
+                                   const mpmc_grid *g, double *restrict fb, const mpmc_pw *pw,
+                                   double vj) {
   const int S = mpmc_stencil(BASIS);
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
   const mpmc_b4d wxv = (mpmc_b4d){pw->w[0][0], pw->w[1][0], S > 2 ? pw->w[2][0] : 0.0,
@@ -49,7 +55,7 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const mpmc_gr
   for (int k = 0; k < (DIM == 3 ? S : 1); ++k) {
     const mpmc_b4d wzv = DIM == 3 ? wxv * pw->w[k][2] : wxv;
     double *f = fb + pw->node0 + sz * (size_t)k;
-    for (int j = 0; j < S; ++j) fb_row(S, f + sy * (size_t)j, wzv * pw->w[j][1]);
+    for (int j = 0; j < S; ++j) fb_row(S, WIDE, f + sy * (size_t)j, wzv * pw->w[j][1]);
   }
 }
 
@@ -57,8 +63,8 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const mpmc_gr
  * stencil the sums over the row's node records, sw = sum w_x rec and sd = sum w_x' rec, give
  *   (v_pic, dv) += wyz sw,  L_a. += (wyz sd_va, dyz sw_va, ydz sw_va),
  * all whole-vector multiply-adds in record layout; the components are picked out once.
- * FB = 1: also scatter V^n j of Algorithm 1 step 3 into fb (the grid's fbj, one value per
- * node) with the same weights (the points are still at x^n; V^n itself P2G scattered into
+ * FB = 1 (3: in rows of four, fb_scatter): also scatter V^n j of Algorithm 1 step 3 into fb
+ * (the grid's fbj, one value per node) with the same weights (the points are still at x^n; V^n itself P2G scattered into
  * the records' MPMC_VSLOT); FB = 2 (the stable form): scatter V^n and V^n J into fb (the
  * grid's fb, pairs) with the weights of its own space (transfer.h); either way the caller
  * runs the points in slab colours. */
@@ -125,7 +131,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     mpmc_stable_weights(DIM, BASIS, g, p->x + qd, &sp);
     MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
   }
-  if (FB == 1) fb_scatter(DIM, BASIS, g, fb, &pw, vj);
+  if (FB == 1 || FB == 3) fb_scatter(DIM, BASIS, FB == 3, g, fb, &pw, vj);
   if (SPLIT) {
     MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
       mpmc_vd sw[MPMC_NV];
@@ -156,10 +162,12 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
 }
 
 /* g2p_point with F-bar's scatter into fbuf, in form fb (1: Algorithm 1's weights, V^n j into
- * the grid's fbj or a copy of it; 2: the stable form's, into fb or a copy) */
-MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS, int fb, double dt,
-                                   const g2p_ctx *c, double *restrict fbuf, int q) {
+ * the grid's fbj or a copy of it, in rows of four nodes with wide (fb_scatter); 2: the stable
+ * form's, into fb or a copy) */
+MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS, int fb, int wide,
+                                   double dt, const g2p_ctx *c, double *restrict fbuf, int q) {
   return fb == 2 ? g2p_point(sim, DIM, BASIS, 2, dt, c, fbuf, q)
+         : wide  ? g2p_point(sim, DIM, BASIS, 3, dt, c, fbuf, q)
                  : g2p_point(sim, DIM, BASIS, 1, dt, c, fbuf, q);
 }
 
@@ -188,17 +196,18 @@ MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS,
         double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                  \
         const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                               \
         for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1_; ++k)                        \
-          if (!g2pfb_point(sim, D, B, fb, dt, c, f_, order[k]) && order[k] < first_bad)      \
+          if (!g2pfb_point(sim, D, B, fb, 0, dt, c, f_, order[k]) && order[k] < first_bad)   \
             first_bad = order[k];                                                            \
       }                                                                                      \
       *bad = first_bad == INT_MAX ? -1 : first_bad;                                          \
       return;                                                                                \
     }                                                                                        \
+    const int wide = sim->slab_axis != 0; /* rows along x lie within a slab */               \
     for (int colour = 0; colour < 2; ++colour) {                                             \
       _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
         for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
-          if (!g2pfb_point(sim, D, B, fb, dt, c, fb0, order[k]) && order[k] < first_bad)     \
+          if (!g2pfb_point(sim, D, B, fb, wide, dt, c, fb0, order[k]) && order[k] < first_bad) \
             first_bad = order[k];                                                            \
     }                                                                                        \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
