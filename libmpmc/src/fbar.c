@@ -62,6 +62,11 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
     }
 }
 
+/* cbrt_near1's polynomial in e (e2 = e e), for scalars and for gather_scale4's vectors */
+#define CBRT_NEAR1_POLY(e, e2)                                                                \
+  ((1.0 + (e) * (1.0 / 3.0)) +                                                               \
+   (e2) * ((-1.0 / 9.0 + (e) * (5.0 / 81.0)) + (e2) * (-10.0 / 243.0 + (e) * (22.0 / 729.0))))
+
 /* r^(1/3) for r near 1 (e = r - 1).  |e| < 0.004, the usual case: the Taylor polynomial to
  * e^5 (truncation below 1e-16) in Estrin's form, a short dependency chain; |e| < 0.05:
  * y = r^(-1/3) by Newton's division-free iteration y <- y + y (1 - r y^3) / 3 from
@@ -71,8 +76,7 @@ static inline double cbrt_near1(double r) {
   const double e = r - 1.0;
   if (fabs(e) < 0.004) {
     const double e2 = e * e;
-    return (1.0 + e * (1.0 / 3.0)) +
-           e2 * ((-1.0 / 9.0 + e * (5.0 / 81.0)) + e2 * (-10.0 / 243.0 + e * (22.0 / 729.0)));
+    return CBRT_NEAR1_POLY(e, e2);
   }
   if (!(fabs(e) < 0.05)) return cbrt(r);
   double y = 1.0 + e * (-1.0 / 3.0 + e * (2.0 / 9.0));
@@ -178,8 +182,7 @@ MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BAS
   const mpmc_b4l small = (mpmc_b4d)((mpmc_b4l)e & magn) < 0.004;       /* |e| < 0.004, not NaN */
   if (DIM == 3 && small[0] & small[1] & small[2] & small[3]) { /* cbrt_near1's first branch */
     const mpmc_b4d e2 = e * e;
-    *(mpmc_b4du *)scale = (1.0 + e * (1.0 / 3.0)) +
-                          e2 * ((-1.0 / 9.0 + e * (5.0 / 81.0)) + e2 * (-10.0 / 243.0 + e * (22.0 / 729.0)));
+    *(mpmc_b4du *)scale = CBRT_NEAR1_POLY(e, e2);
   } else {
     for (int l = 0; l < 4; ++l) scale[l] = DIM == 2 ? sqrt(r[l]) : cbrt_near1(r[l]);
   }

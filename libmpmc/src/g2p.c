@@ -42,9 +42,9 @@ MPMC_ALWAYS_INLINE void fb_row(const int S, const int WIDE, double *restrict f, 
  * fbj_i += ((w_x vj) w_z) w_y, per plane of rows the x-weights times vj times w_z as one
  * vector, then per row one vector multiply and add (fbar.c's scatter_point the same).
  * WIDE: rows of three nodes as four (the fourth plus 0), where the node after a row is
- * written by this thread alone: each thread into its own copy of fbj, or slabs across y or
- * z, as the row then lies in this slab's planes, which no point of a slab of the same colour
- * reaches (fbj has four nodes to spare at its end). */
+ * written by this thread alone: with slabs across y or z that node lies in the row's plane,
+ * one of this slab's, which no point of a slab of the same colour reaches; it is in the same
+ * grid row (a stencil ends at least one node before a row's last ghost node). */
 MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WIDE,
                                    const mpmc_grid *g, double *restrict fb, const mpmc_pw *pw,
                                    double vj) {
@@ -64,10 +64,10 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
  *   (v_pic, dv) += wyz sw,  L_a. += (wyz sd_va, dyz sw_va, ydz sw_va),
  * all whole-vector multiply-adds in record layout; the components are picked out once.
  * FB = 1 (3: in rows of four, fb_scatter): also scatter V^n j of Algorithm 1 step 3 into fb
- * (the grid's fbj, one value per node) with the same weights (the points are still at x^n; V^n itself P2G scattered into
- * the records' MPMC_VSLOT); FB = 2 (the stable form): scatter V^n and V^n J into fb (the
- * grid's fb, pairs) with the weights of its own space (transfer.h); either way the caller
- * runs the points in slab colours. */
+ * (the grid's fbj, one value per node) with the same weights (the points are still at x^n;
+ * V^n itself P2G scattered into the records' MPMC_VSLOT); FB = 2 (the stable form): scatter
+ * V^n and V^n J into fb (the grid's fb, pairs) with the weights of its own space
+ * (transfer.h); either way the caller runs the points in slab colours. */
 MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, const int FB,
                                  double dt, const g2p_ctx *c, double *restrict fb, int q) {
   mpmc_grid *g = &sim->grid;
