@@ -152,11 +152,12 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     dv[i] = A[sf / MPMC_VW][sf % MPMC_VW];
   }
   double *v = p->v + qd;
+  const double eta = c->eta, pic = 1.0 - eta; /* in registers: v and xout might alias c */
   for (int a = 0; a < DIM; ++a) {
-    v[a] = c->eta * (v[a] + dv[a]) + (1.0 - c->eta) * vpic[a];
+    v[a] = eta * (v[a] + dv[a]) + pic * vpic[a];
     const double xa = p->x[qd + a] + dt * vpic[a];
     c->xout[qd + a] = xa;
-    ok &= xa >= c->xmin[a] && xa <= c->xmax[a];
+    ok &= (xa >= c->xmin[a]) & (xa <= c->xmax[a]);
   }
   return ok;
 }
