@@ -22,7 +22,9 @@ typedef struct {
  * sums are the scalar ones).  Three nodes: with WIDE all four lanes (v[3] = 0 adds nothing
  * to a node that no other thread writes meanwhile: fb_scatter), else AVX2's masked load and
  * store, which leave the fourth node alone, else two plus one. */
-MPMC_ALWAYS_INLINE void fb_row(const int S, const int WIDE, double *restrict f, mpmc_b4d v) {
+MPMC_ALWAYS_INLINE void fb_row(const int S, const int WIDE, double *restrict f,
+                               const mpmc_b4d *vp) { /* by pointer: basis.h, mpmc_floor4 */
+  const mpmc_b4d v = *vp;
   if (S == 2) {
     MPMC_V2(f) += (mpmc_v2d){v[0], v[1]};
   } else if (S == 4 || WIDE) {
@@ -55,7 +57,10 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
   for (int k = 0; k < (DIM == 3 ? S : 1); ++k) {
     const mpmc_b4d wzv = DIM == 3 ? wxv * pw->w[k][2] : wxv;
     double *f = fb + pw->node0 + sz * (size_t)k;
-    for (int j = 0; j < S; ++j) fb_row(S, WIDE, f + sy * (size_t)j, wzv * pw->w[j][1]);
+    for (int j = 0; j < S; ++j) {
+      const mpmc_b4d add = wzv * pw->w[j][1];
+      fb_row(S, WIDE, f + sy * (size_t)j, &add);
+    }
   }
 }
 
