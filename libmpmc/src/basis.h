@@ -90,9 +90,28 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, 
   }
 }
 
+/* The weights of the polynomial bases from f, the point's offset (in cells) from its first
+ * stencil node, written once for scalars (T double: mpmc_basis_1d) and for vectors (T
+ * mpmc_b4d: mpmc_poly_lanes), so both make the same operations and the same bits. */
+#define MPMC_LINEAR_W(T, f, w) ((w)[0] = 1.0 - (f), (w)[1] = (f))
+#define MPMC_BSPLINE2_W(T, f, w)                                                  \
+  do {                                                                            \
+    const T x1_ = (f) - 1.0; /* f in [0.5, 1.5) */                                \
+    (w)[0] = 0.5 * (1.5 - (f)) * (1.5 - (f));                                     \
+    (w)[1] = 0.75 - x1_ * x1_;                                                    \
+    (w)[2] = 0.5 * ((f) - 0.5) * ((f) - 0.5);                                     \
+  } while (0)
+#define MPMC_BSPLINE3_W(T, f, w)                                                  \
+  do { /* f in [1, 2): node 0 at distance f, 1 at f - 1, 2 at 2 - f, 3 at 3 - f */ \
+    const T x0_ = 2.0 - (f), x1_ = (f) - 1.0;                                     \
+    (w)[0] = x0_ * x0_ * x0_ / 6.0;                                               \
+    (w)[1] = 0.5 * x1_ * x1_ * x1_ - x1_ * x1_ + 2.0 / 3.0;                       \
+    (w)[2] = 0.5 * x0_ * x0_ * x0_ - x0_ * x0_ + 2.0 / 3.0;                       \
+    (w)[3] = x1_ * x1_ * x1_ / 6.0;                                               \
+  } while (0)
+
 /* The linear and B-spline weights in the lanes of s = (x_p - origin)/h (four points along
- * one axis: fbar.c's gather), with mpmc_basis_1d's operations (the floor exact in either),
- * hence its bits; no gradients. */
+ * one axis: fbar.c's gather), the floor exact as mpmc_basis_1d's; no gradients. */
 MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, mpmc_b4i *base,
                                         mpmc_b4da *w) {
   const mpmc_b4d s = *sp;
@@ -100,25 +119,17 @@ MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, mpm
   if (basis == MPMC_BASIS_LINEAR) {
     mpmc_floor4(&s, base, &fl);
     const mpmc_b4d f = s - fl;
-    w[0] = 1.0 - f;
-    w[1] = f;
+    MPMC_LINEAR_W(mpmc_b4d, f, w);
   } else if (basis == MPMC_BASIS_BSPLINE2) {
     const mpmc_b4d sh = s - 0.5;
     mpmc_floor4(&sh, base, &fl);
-    const mpmc_b4d f = s - fl; /* in [0.5, 1.5) */
-    const mpmc_b4d x1 = f - 1.0;
-    w[0] = 0.5 * (1.5 - f) * (1.5 - f);
-    w[1] = 0.75 - x1 * x1;
-    w[2] = 0.5 * (f - 0.5) * (f - 0.5);
+    const mpmc_b4d f = s - fl;
+    MPMC_BSPLINE2_W(mpmc_b4d, f, w);
   } else { /* cubic */
     mpmc_floor4(&s, base, &fl);
     *base -= 1;
-    const mpmc_b4d f = s - (fl - 1.0); /* in [1, 2) */
-    const mpmc_b4d x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
-    w[0] = x0 * x0 * x0 / 6.0;
-    w[1] = 0.5 * x1 * x1 * x1 - x1 * x1 + 2.0 / 3.0;
-    w[2] = 0.5 * x2 * x2 * x2 - x2 * x2 + 2.0 / 3.0;
-    w[3] = x3 * x3 * x3 / 6.0;
+    const mpmc_b4d f = s - (fl - 1.0);
+    MPMC_BSPLINE3_W(mpmc_b4d, f, w);
   }
 }
 
@@ -131,8 +142,7 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       const int b = mpmc_ifloor(s);
       const double f = s - b;
       *base = b;
-      w[0] = 1.0 - f;
-      w[1] = f;
+      MPMC_LINEAR_W(double, f, w);
       dw[0] = -inv_h;
       dw[1] = inv_h;
       break;
@@ -142,9 +152,7 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       const double f = s - b; /* in [0.5, 1.5) */
       const double x1 = f - 1.0;
       *base = b;
-      w[0] = 0.5 * (1.5 - f) * (1.5 - f);
-      w[1] = 0.75 - x1 * x1;
-      w[2] = 0.5 * (f - 0.5) * (f - 0.5);
+      MPMC_BSPLINE2_W(double, f, w);
       dw[0] = -(1.5 - f) * inv_h;
       dw[1] = -2.0 * x1 * inv_h;
       dw[2] = (f - 0.5) * inv_h;
@@ -154,12 +162,8 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       const int b = mpmc_ifloor(s) - 1;
       const double f = s - b; /* in [1, 2) */
       const double x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
-      /* node 0 at distance f, 1 at f-1, 2 at 2-f (negative side), 3 at 3-f */
       *base = b;
-      w[0] = x0 * x0 * x0 / 6.0;
-      w[1] = 0.5 * x1 * x1 * x1 - x1 * x1 + 2.0 / 3.0;
-      w[2] = 0.5 * x2 * x2 * x2 - x2 * x2 + 2.0 / 3.0;
-      w[3] = x3 * x3 * x3 / 6.0;
+      MPMC_BSPLINE3_W(double, f, w);
       dw[0] = -0.5 * x0 * x0 * inv_h;
       dw[1] = (1.5 * x1 * x1 - 2.0 * x1) * inv_h;
       dw[2] = -(1.5 * x2 * x2 - 2.0 * x2) * inv_h;
