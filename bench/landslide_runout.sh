@@ -25,7 +25,7 @@ if [ ! -f "$work/s0/checkpoint.h5" ]; then
     --set grid.cell_size=0.2 --set 'grid.hi=[55,0.2,6]' --set geometry.0.file=../meshes/slope_3d_strip.geo \
     --set stages.2.end.time=0.0005 --set 'snapshot_plots=[]')
 fi
-# the strip to later run-out times: the last checkpoint before each end (every 2 s of wall)
+# the strip to later run-out times (the checkpoint at each end)
 prev=s0
 for st in 1:1.0 2:2.5 3:4.0; do
   k=${st%%:*}
@@ -38,7 +38,7 @@ done
 dt=$(awk "BEGIN{print $steps * 5e-5}")
 for k in 0 1 2 3; do
   # the timed run resumes from the strip's state at its own stage time: end = that + STEPS dt
-  t0=$($py -c "import h5py,re; m=h5py.File('$work/s$k/checkpoint.h5','r').attrs['meta'].decode(); print(re.search(r'stage_time (\S+)', m).group(1))")
+  t0=$($tile --time "$work/s$k")
   $tile "$work/s$k" "$work/f$k" 25 "$(awk "BEGIN{printf \"%.10g\", $t0 + $dt}")" "$threads"
   "$bin" resume "$work/f$k" --quiet
   $py - "$work/f$k" "$work/s$k" "$steps" "$t0" <<'EOF'

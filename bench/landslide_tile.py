@@ -2,13 +2,15 @@
 """The full-width 3D landslide from its 0.2 m strip, for the run-out benchmark (issue 6).
 
 usage: landslide_tile.py STRIP_DIR OUT_DIR COPIES END_TIME THREADS
+       landslide_tile.py --time DIR       (prints the run-out time of DIR/checkpoint.h5)
 
 STRIP_DIR holds the checkpoint of `mpmc run workflows/slope_3d.yaml` with the strip
 overrides (bench/landslide_runout.sh); the strip is one cell (0.2 m) wide with slip walls on
 both sides, so COPIES of it side by side along y are the slope COPIES x 0.2 m wide in the
 same state, point for point (docs/landslide.md).  OUT_DIR/checkpoint.h5 is that slope with
 the run-out stage to end at END_TIME (stage time, s) on THREADS threads; `mpmc resume OUT_DIR`
-continues it.  Needs h5py (Debian: python3-h5py).
+continues it (from a finished run's checkpoint too: the run-out's end raised, resume goes on
+from where it ended).  Needs h5py (Debian: python3-h5py).
 """
 import os
 import re
@@ -17,6 +19,15 @@ import sys
 
 import h5py
 import numpy as np
+
+
+def runout_time(meta):
+    """The run-out stage's time in a workflow checkpoint's record: its stage_time while the
+    run-out (stage 2) is under way, the time it ended at when the run finished (stage 3)."""
+    stage = int(re.search(r"^stage (\d+)$", meta, re.M).group(1))
+    if stage < 3:
+        return float(re.search(r"^stage_time (\S+)$", meta, re.M).group(1))
+    return float(re.findall(r"^done (\S+) ", meta, re.M)[2])
 
 
 def main(src, dst, copies, end_time, threads):
@@ -89,14 +100,16 @@ def main(src, dst, copies, end_time, threads):
             meta = re.sub(r"set grid\.hi=\S+\n", "", meta)
             meta = re.sub(r"set geometry\.0\.file=\S+\n", "", meta)
         meta = re.sub(r"set checkpoint_interval=\S+\n", "", meta)
-        # the last stage writes no checkpoint at its end: the strip (COPIES = 1, the chain to
-        # later run-out times) every 2 s of wall time, the timed runs none
-        meta = meta.replace("set snapshot_plots=[]\n", "set snapshot_plots=[]\nset checkpoint_interval=%d\n"
-                            % (2 if copies == 1 else 100000))
+        # no checkpoints within the run: the one at its end is the state the chain goes on from
+        meta = meta.replace("set snapshot_plots=[]\n", "set snapshot_plots=[]\nset checkpoint_interval=100000\n")
         f.attrs["meta"] = np.bytes_(meta)
 
 
 if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--time":
+        with h5py.File(os.path.join(sys.argv[2], "checkpoint.h5"), "r") as f:
+            print(repr(runout_time(f.attrs["meta"].decode())))
+        sys.exit(0)
     if len(sys.argv) != 6:
         sys.exit(__doc__)
     main(sys.argv[1], sys.argv[2], int(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5]))

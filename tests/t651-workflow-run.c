@@ -4,8 +4,10 @@
  *   step dt the explicit update (v += g dt, then x += v dt) gives after n steps
  *   u_y = -g dt^2 n (n + 1) / 2, and the centre of mass keeps its x;
  * - a box scene must not load libgmsh (/proc/self/maps);
- * - `mpmc check` writes nothing; `mpmc resume` from the checkpoint between the stages ends
- *   in the same state;
+ * - `mpmc check` writes nothing; a finished run's checkpoint is its end: `mpmc resume`
+ *   refuses it (and leaves summary.json alone) until the scene has another stage, then runs
+ *   that stage alone, ending where the three stages run uninterrupted end (u_y above,
+ *   n = 150);
  * - slope_2d with the standard formulation (F-bar off) locks and does not run out;
  * - a wall on a gmsh boundary group's node set (Cook's "clamp", the nodes x = 0, y = 0..44)
  *   gives the same run as a box wall on those nodes; an unknown set is named in the error. */
@@ -59,12 +61,25 @@ static double json_number(const char *path, const char *key) {
   return strtod(p + strlen(pat), NULL);
 }
 
-static void write_scene(const char *path) {
+static void write_text(const char *path, const char *text) {
   mkdir(DIR, 0777);
   FILE *f = fopen(path, "w");
   assert_non_null(f);
-  fputs(scene_text, f);
+  fputs(text, f);
   fclose(f);
+}
+
+static void write_scene(const char *path) { write_text(path, scene_text); }
+
+/* The whole of a file, NUL-terminated (static storage: one at a time). */
+static const char *slurp(const char *path) {
+  static char buf[1 << 16];
+  FILE *f = fopen(path, "r");
+  if (!f) fail_msg("cannot read %s", path);
+  const size_t n = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[n] = '\0';
+  return buf;
 }
 
 static void test_free_fall(void **state) {
@@ -113,19 +128,66 @@ static void test_check_and_resume(void **state) {
   if (run_cli("check '" DIR "/fall.yaml' --out '" DIR "/out-check'") != 0) fail_msg("mpmc check: expected exit 0");
   if (exists(DIR "/out-check")) fail_msg("mpmc check created its output directory");
   if (run_cli("run '" DIR "/fall.yaml' --out '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc run: expected exit 0");
-  const double first = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
   if (!exists(DIR "/out-resume/checkpoint.h5")) {
     /* a build without checkpoints says so */
     if (run_cli("resume '" DIR "/out-resume'") == 0) fail_msg("resume without a checkpoint: expected a failure");
     return;
   }
-  /* the checkpoint holds the state at the start of stage 2: resuming repeats stage 2 */
-  if (run_cli("resume '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc resume: expected exit 0");
-  const double again = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
-  if (fabs(again - first) > 1e-12 * fabs(first))
-    fail_msg("resume: tip_displacement_y expected %.15g (the uninterrupted run), got %.15g", first, again);
+  /* the checkpoint is the finished run: nothing to resume, and the outputs stay as they are */
+  char before[1 << 16];
+  snprintf(before, sizeof before, "%s", slurp(DIR "/out-resume/summary.json"));
+  if (run_cli("resume '" DIR "/out-resume' --quiet") == 0) fail_msg("resume of a finished run: expected a failure");
+  if (strcmp(before, slurp(DIR "/out-resume/summary.json")) != 0)
+    fail_msg("resume of a finished run rewrote summary.json");
+  /* the message says what to do */
+  char cmd[1024], msg[2048] = "";
+  snprintf(cmd, sizeof cmd, "'%s' resume '" DIR "/out-resume' 2>&1", MPMC_CLI);
+  FILE *pipe = popen(cmd, "r");
+  assert_non_null(pipe);
+  const size_t nm = fread(msg, 1, sizeof msg - 1, pipe);
+  msg[nm] = '\0';
+  if (pclose(pipe) == 0) fail_msg("resume of a finished run: expected a failure");
+  if (!strstr(msg, "finished all 2 stages") || !strstr(msg, "add a stage"))
+    fail_msg("resume of a finished run: expected 'finished all 2 stages ... add a stage', got: %s", msg);
+  /* one more stage in the scene: resuming runs it alone */
+  char three[4096];
+  snprintf(three, sizeof three, "%s", scene_text);
+  char *at = strstr(three, "metrics:");
+  assert_non_null(at);
+  const char *metrics = strstr(scene_text, "metrics:");
+  snprintf(at, sizeof three - (size_t)(at - three), "  - {name: third, dt: 0.001, end: {time: 0.05}}\n%s", metrics);
+  write_text(scene, three);
+  if (run_cli("resume '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc resume with a third stage: expected exit 0");
   const double steps = json_number(DIR "/out-resume/summary.json", "steps");
-  if (steps != 100) fail_msg("resume: expected 100 steps in all, got %g", steps);
+  if (steps != 150) fail_msg("resume: expected 150 steps in all, got %g", steps);
+  const double g = 9.81, dt = 0.001;
+  const int n = 150;
+  const double expect = -g * dt * dt * n * (n + 1) / 2.0;
+  const double again = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
+  if (fabs(again - expect) > 1e-9 * fabs(expect))
+    fail_msg("resume: tip_displacement_y expected %.12g (three stages of free fall), got %.12g", expect, again);
+  if (!strstr(slurp(DIR "/out-resume/summary.json"), "\"third\""))
+    fail_msg("resume: summary.json names no stage 'third'");
+  /* the last stage's end raised from 0.05 to 0.08 s: it goes on from where it ended */
+  char *end = strstr(three, "{name: third, dt: 0.001, end: {time: 0.05}}");
+  assert_non_null(end);
+  memcpy(strstr(end, "0.05"), "0.08", 4);
+  write_text(scene, three);
+  if (run_cli("resume '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc resume with a later end: expected exit 0");
+  const double steps2 = json_number(DIR "/out-resume/summary.json", "steps");
+  if (steps2 != 180) fail_msg("resume to a later end: expected 180 steps in all, got %g", steps2);
+  const double expect2 = -g * dt * dt * 180 * 181 / 2.0;
+  const double uy2 = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
+  if (fabs(uy2 - expect2) > 1e-9 * fabs(expect2))
+    fail_msg("resume to a later end: tip_displacement_y expected %.12g, got %.12g", expect2, uy2);
+  /* and once more with nothing changed: finished, after three stages */
+  pipe = popen(cmd, "r");
+  assert_non_null(pipe);
+  const size_t nm2 = fread(msg, 1, sizeof msg - 1, pipe);
+  msg[nm2] = '\0';
+  if (pclose(pipe) == 0) fail_msg("resume of the finished run: expected a failure");
+  if (!strstr(msg, "finished all 3 stages") || !strstr(msg, "raise the last stage's end time"))
+    fail_msg("resume of a finished run: expected 'finished all 3 stages ... raise the last stage's end time', got: %s", msg);
 }
 
 static void test_slope_locks_without_fbar(void **state) {

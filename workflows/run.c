@@ -654,7 +654,13 @@ static int run_all(wf_run *w, int first_stage, double t_stage, long steps, doubl
     if (!(i == first_stage && t_stage > 0)) w->ke_below = -1.0; /* else restored from the checkpoint */
     if (run_stage(w, i, i == first_stage ? t_stage : 0, &steps, i == first_stage ? ke_max : 0, &pr)) return -1;
 #ifdef MPMC_WF_HAVE_CHECKPOINT
+    /* at the start of the next stage; after the last one, the finished run (stage = nstage),
+     * which `mpmc resume` continues once the scene has another stage: that one only warns
+     * when it cannot be written, the run itself is done and its outputs follow */
     if (i + 1 < w->sc.nstage && checkpoint(w, i + 1, 0, steps, 0, 0)) return -1;
+    if (i + 1 == w->sc.nstage && checkpoint(w, i + 1, 0, steps, 0, 0))
+      say(w, "warning: the final checkpoint: %s (the run is complete; it cannot be extended by `mpmc resume`)",
+          mpmc_context_last_error(w->ctx));
 #endif
   }
   return 0;
@@ -822,14 +828,49 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
   w.t_start = wf_now();
   w.noverride = nset;
   w.overrides = (const char *const *)sets;
-  snprintf(w.out, sizeof w.out, "%s", outdir);
+  /* the walls the checkpoint records: those of its stages, or of more (not yet added) */
+  int walls_before = 0; /* of the stages up to the one resumed */
   if (bad || stage < 0 || !scene[0]) {
     err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "resume: %s was not written by the workflow (no stage record)", path);
   } else if (prepare(&w, scene, nset, w.overrides)) {
     err = ctx->last_code;
-  } else if (nwall != w.nwall_ids || ndone != stage || stage >= w.sc.nstage) {
-    err = fail(&w, MPMC_ERR_FORMAT, "resume: the scene %s no longer matches the checkpoint (stages or walls changed)", scene);
   } else {
+    /* a stage's walls are added by its setup */
+    for (int i = 0; i < stage + (setup != 0) && i < w.sc.nstage; ++i) walls_before += w.sc.stages[i].nwalls;
+  }
+  /* errors before this point leave the outputs as they are (w.out empty: finish writes no
+   * summary); a finished run is not a failed one */
+  double t_ckpt = 0.0;
+  if (sim) mpmc_sim_get_time(sim, &t_ckpt);
+  /* A finished run (the checkpoint after its last stage) continues with the stages added to
+   * the scene since, or its last stage from where it ended when that stage's end time was
+   * raised (an end by time; not one that came to rest) */
+  if (!err && stage == w.sc.nstage && ndone == stage && stage > 0) {
+    const wf_stage *last = &w.sc.stages[stage - 1];
+    const stage_record *r = &done[stage - 1];
+    if (strcmp(r->reason, "quasi_static") != 0 && last->end_time > r->sim_time * (1 + 1e-9)) {
+      t_stage = r->sim_time; /* the last stage again, at its old end, set up */
+      --stage;
+      --ndone;
+      setup = 1;
+      ke_max = 0.0; /* used by quasi-static ends only */
+      ke_below = -1.0;
+    } else {
+      err = fail(&w, MPMC_ERR_STATE,
+                 "resume: the run in %s finished all %d stages of %s (checkpoint at t = %.6g s, stage '%s' "
+                 "ended by %s at %.6g s); to continue it, add a stage to the scene%s and resume again",
+                 outdir, stage, scene, t_ckpt, last->name, r->reason, r->sim_time,
+                 strcmp(r->reason, "quasi_static") ? " or raise the last stage's end time" : "");
+    }
+  }
+  if (err) {
+  } else if (nwall < walls_before || nwall > w.nwall_ids || ndone != stage || stage > w.sc.nstage) {
+    err = fail(&w, MPMC_ERR_FORMAT,
+               "resume: the scene %s no longer matches the checkpoint (stages or walls changed: %d stages "
+               "done, %d walls recorded; the scene has %d stages, %d walls)",
+               scene, ndone, nwall, w.sc.nstage, w.nwall_ids);
+  } else {
+    snprintf(w.out, sizeof w.out, "%s", outdir);
     if (nwall) memcpy(w.wall_ids, walls, sizeof *walls * (size_t)nwall);
     for (int i = 0; i < ndone; ++i) {
       w.rec[i] = done[i];
@@ -837,7 +878,7 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
     }
     w.sim = sim;
     w.ckpt_ok = 1; /* the checkpoint resumed from is the last good state until the next one */
-    mpmc_sim_get_time(w.sim, &w.ckpt_time);
+    w.ckpt_time = t_ckpt;
     w.strength = strength;
     w.ke_below = ke_below;
     set_threads(&w);
