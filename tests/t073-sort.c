@@ -6,8 +6,9 @@
  * and a user material whose state is each point's own history.  Also: the sort really puts
  * the points in cell order, field pointers stay valid, the ids are the indices points were
  * added with (new points too), a checkpoint carries ids and the sort schedule (the restarted
- * run is the same bits as the straight one), an error names a moved point by index and id,
- * and bad input is refused. */
+ * run is the same bits as the straight one), a change of the slab axis brings the next sort
+ * forward (restarts alike), an error names a moved point by index and id, and bad input is
+ * refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -365,11 +366,79 @@ static void test_checkpoint(void **state) {
   mpmc_context_destroy(&ctx);
 }
 
+/* A tall 3D block (30 cell planes along z: slab axis z) squashed to 3 planes: the slab build
+ * then slabs along y (the longest extent left, ties to the outermost), and the run sorts for
+ * that within a tenth of its interval instead of waiting for the interval; a checkpoint taken
+ * between the axis change and that sort restarts to the same bits (it carries both axes). */
+static mpmc_sim tall_block(mpmc_context ctx) {
+  mpmc_sim sim;
+  TCALL(mpmc_sim_create(ctx, 3, &sim));
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 4};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
+  TCALL(mpmc_sim_set_threads(sim, 1));
+  TCALL(mpmc_sim_set_sort_interval(sim, 50));
+  int mat, n;
+  TCALL(mpmc_sim_add_material_hencky(sim, 1e5, 0.3, 1000, &mat));
+  const double blo[3] = {0.2, 0.2, 0.2}, bhi[3] = {0.6, 0.6, 3.2};
+  TCALL(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, &n));
+  shuffle(sim, 11u);
+  return sim;
+}
+
+/* cell coordinate of point q along axis a */
+static int cell_of(const mpmc_sim sim, int q, int a) { return (int)(sim->p.x[(size_t)q * 3 + a] * 10.0); }
+
+static void test_axis_change(void **state) {
+  (void)state;
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  char path[64];
+  snprintf(path, sizeof path, "t073-axis-%ld.h5", (long)getpid());
+  mpmc_sim a = tall_block(ctx);
+  const int n = a->p.n;
+  double dt;
+  TCALL(mpmc_sim_stable_dt(a, 0.3, &dt));
+  TCALL(mpmc_sim_step(a, dt)); /* sorts first, with z outermost */
+  for (int q = 1; q < n; ++q)
+    if (cell_of(a, q, 2) < cell_of(a, q - 1, 2)) fail_msg("after the first sort: z cells not in order at %d", q);
+  double *x;
+  TCALL(mpmc_sim_get_field(a, MPMC_FIELD_POSITION, &x, NULL));
+  for (int q = 0; q < n; ++q) x[q * 3 + 2] = 0.2 + 0.1 * (x[q * 3 + 2] - 0.2); /* 3 planes */
+  TCALL(mpmc_sim_restore_field(a, MPMC_FIELD_POSITION, &x));
+  TCALL(mpmc_sim_step(a, dt)); /* its slab build picks y */
+  TCALL(mpmc_sim_checkpoint_write(a, path, NULL));
+  mpmc_sim b;
+  TCALL(mpmc_sim_checkpoint_read(ctx, path, &b, NULL));
+  unlink(path);
+  for (int s = 0; s < 5; ++s) { /* step 5 (a tenth of 50) sorts */
+    TCALL(mpmc_sim_step(a, dt));
+    TCALL(mpmc_sim_step(b, dt));
+  }
+  const int *ia, *ib;
+  for (int k = 0; k < 2; ++k) {
+    const mpmc_sim s = k ? b : a;
+    for (int q = 1; q < n; ++q)
+      if (cell_of(s, q, 1) < cell_of(s, q - 1, 1))
+        fail_msg("%s run, 5 steps after the slab axis became y: the points are not sorted by y cell (point %d)",
+                 k ? "restarted" : "straight", q);
+  }
+  TCALL(mpmc_sim_get_particle_ids(a, &ia));
+  TCALL(mpmc_sim_get_particle_ids(b, &ib));
+  if (memcmp(ia, ib, sizeof(int) * (size_t)n)) fail_msg("ids differ after the restart");
+  if (memcmp(a->p.x, b->p.x, sizeof(double) * 3 * (size_t)n) || memcmp(a->p.v, b->p.v, sizeof(double) * 3 * (size_t)n))
+    fail_msg("the restarted run differs from the straight one");
+  mpmc_sim_destroy(&a);
+  mpmc_sim_destroy(&b);
+  mpmc_context_destroy(&ctx);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_sorted_equals_unsorted),
       cmocka_unit_test(test_ids),
       cmocka_unit_test(test_checkpoint),
+      cmocka_unit_test(test_axis_change),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -74,6 +74,10 @@ static int write_config(hid_t f, const mpmc_sim sim) {
                            sim->stats.phase_seconds);
   const int64_t sort[2] = {sim->sort_every, sim->sort_last}; /* interval, step of the last */
   st |= mpmc_h5_attr_write(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
+  /* the axis the last sort ordered by and the last slab build's: whether the next step sorts
+   * because the slab axis changed (sort.c, mpmc_sort_due) */
+  const int axes[2] = {sim->sort_axis, sim->slab_axis};
+  st |= mpmc_h5_attr_write(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
   H5Gclose(g);
   return st < 0 ? -1 : 0;
 }
@@ -104,6 +108,9 @@ static int read_config(hid_t f, mpmc_sim sim) {
   int64_t sort[2] = {0, -1}; /* absent in files of before the sort: never sorted */
   if (H5Aexists(g, "sort_interval_last") > 0)
     st |= mpmc_h5_attr_read(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
+  int axes[2] = {-1, 0}; /* absent in files of before: no sort for an axis change until the next */
+  if (H5Aexists(g, "sort_axis_slab_axis") > 0)
+    st |= mpmc_h5_attr_read(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
   H5Gclose(g);
   MPMC_CHECK(st >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint /config: missing or malformed attributes");
   MPMC_CHECK(ints[0] == sim->dim, ctx, MPMC_ERR_FORMAT,
@@ -133,6 +140,10 @@ static int read_config(hid_t f, mpmc_sim sim) {
              (long long)sort[0], (long long)sort[1]);
   sim->sort_every = (int)sort[0];
   sim->sort_last = sort[1];
+  MPMC_CHECK(axes[0] >= -1 && axes[0] < sim->dim && axes[1] >= 0 && axes[1] < sim->dim, ctx,
+             MPMC_ERR_FORMAT, "checkpoint /config: bad sort_axis_slab_axis = [%d, %d]", axes[0], axes[1]);
+  sim->sort_axis = axes[0];
+  sim->slab_axis = axes[1];
   return MPMC_SUCCESS;
 }
 

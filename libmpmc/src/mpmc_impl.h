@@ -286,6 +286,7 @@ struct mpmc_sim_s {
   int kernels;                  /* kernel set in use: MPMC_KERNELS_BASELINE or _AVX2   */
   int sort_every;               /* sort the points by cell every this many steps; 0: never */
   int64_t sort_last;            /* step count at the last sort; -1: none yet (sort.c)   */
+  int sort_axis;                /* the slab axis the last sort put outermost; -1: none  */
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),

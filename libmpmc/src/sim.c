@@ -75,6 +75,7 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
   s->flip = 1.0;
   s->solver = MPMC_SOLVER_AUTO;
   s->sort_last = -1;
+  s->sort_axis = -1;
   s->p.dim = dim;
   const int err = kernels_from_env(s);
   if (err) {

@@ -63,7 +63,7 @@ static void permute_ints(int *a, const int *perm, int n, double *tmp) {
  * The halves order the points of a cell alike in every cell, so the kernels' branches (the
  * B-spline stencil starts at the cell below or at the cell itself, uGIMP's four cases) repeat
  * from cell to cell and predict well. */
-static void point_keys(const mpmc_sim sim, double *key, double *half, int *clo, int *chi) {
+static int point_keys(const mpmc_sim sim, double *key, double *half, int *clo, int *chi) {
   const mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim, n = p->n;
@@ -101,6 +101,7 @@ static void point_keys(const mpmc_sim sim, double *key, double *half, int *clo, 
     half[q] = hq;
   }
 #undef CELL_OF
+  return ax;
 }
 
 /**
@@ -143,7 +144,7 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
   int *perm = sim->order;
   int clo[3], chi[3];
   double *key = tmp, *half = tmp + n, *first = tmp + 2 * (size_t)n; /* w >= 3 columns */
-  point_keys(sim, key, half, clo, chi);
+  sim->sort_axis = point_keys(sim, key, half, clo, chi);
   size_t ncell = 1;
   for (int a = 0; a < d; ++a) ncell *= (size_t)(chi[a] - clo[a] + 1);
   int *cnt = calloc(ncell + 1, sizeof *cnt);
@@ -231,7 +232,12 @@ int mpmc_sim_get_particle_ids(mpmc_sim sim, const int **ids) {
 /* step.c: sort before the step when the interval has passed */
 int mpmc_sort_due(mpmc_sim sim) {
   if (sim->sort_every <= 0) return MPMC_SUCCESS;
-  if (sim->sort_last >= 0 && sim->stats.steps - sim->sort_last < sim->sort_every)
-    return MPMC_SUCCESS;
+  const int64_t since = sim->stats.steps - sim->sort_last;
+  /* also soon after the slab axis changed (the last step's slab build chose another than the
+   * sort's, as a collapsing body gets flatter): the storage order then no longer follows the
+   * slabs; at most one such sort per tenth of the interval, should the axis go back and forth */
+  const int flip = sim->sort_axis >= 0 && sim->slab_axis != sim->sort_axis &&
+                   since >= (sim->sort_every + 9) / 10;
+  if (sim->sort_last >= 0 && since < sim->sort_every && !flip) return MPMC_SUCCESS;
   return mpmc_sim_sort_particles(sim);
 }
