@@ -3,7 +3,9 @@
  * the energy check (kinetic energy growing without input) with the step, the point, its
  * position and the cause, well before NaN; a point leaving the grid and a non-finite velocity
  * stop the step with the point named; stable runs with energy input (gravity, initial
- * velocity) are not stopped. */
+ * velocity) are not stopped.  The limit follows the velocities: the max |v| that G2P finds
+ * gives the same bits as a pass over the points, and a velocity written through a borrowed
+ * field counts at once, given back or not. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -78,6 +80,58 @@ static void test_dt_refused(void **state) {
   /* forced: accepted */
   TCALL(mpmc_sim_set_force_dt(sim, 1));
   TCALL(mpmc_sim_step(sim, 2 * limit));
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+}
+
+/* h / (c + max |v|) from the velocity field, summed as the library documents it */
+static double limit_now(mpmc_sim sim, int np) {
+  double *v, v2max = 0.0;
+  TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+  for (int q = 0; q < np; ++q) {
+    const double v2 = v[2 * q] * v[2 * q] + v[2 * q + 1] * v[2 * q + 1];
+    if (v2 > v2max) v2max = v2;
+  }
+  TCALL(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
+  return H / (wave_speed() + sqrt(v2max));
+}
+
+static void test_limit_follows_v(void **state) {
+  (void)state;
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  int np;
+  mpmc_sim sim = block(ctx, &np);
+  perturb(sim, np, 2.0);
+  for (int s = 0; s < 5; ++s) {
+    double dt;
+    TCALL(mpmc_sim_stable_dt(sim, 1.0, &dt)); /* from G2P's max after the first step */
+    const double want = limit_now(sim, np);
+    if (fabs(dt - want) > 1e-15 * want) fail_msg("step %d: limit %.17g, from the velocities %.17g", s, dt, want);
+    TCALL(mpmc_sim_step(sim, 0.5 * dt));
+  }
+  /* a point sped up through a borrowed field that is not given back */
+  double *v, dt;
+  TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+  v[2 * 5] = 40.0;
+  TCALL(mpmc_sim_stable_dt(sim, 1.0, &dt));
+  const double want = H / (wave_speed() + sqrt(40.0 * 40.0 + v[2 * 5 + 1] * v[2 * 5 + 1]));
+  if (fabs(dt - want) > 1e-12 * want) fail_msg("borrowed v: limit %.17g, expected %.17g", dt, want);
+  if (mpmc_sim_step(sim, 1.05 * want) != MPMC_ERR_UNSTABLE) fail_msg("borrowed v: a step above the new limit ran");
+  mpmc_context_clear_error(ctx);
+  TCALL(mpmc_sim_step(sim, 0.3 * want));
+  /* written after a step, still on loan: counts; given back: counts too */
+  v[2 * 9] = -60.0;
+  TCALL(mpmc_sim_stable_dt(sim, 1.0, &dt));
+  if (!(dt <= H / (wave_speed() + 60.0))) fail_msg("v written after a step while borrowed: limit %.17g ignores it", dt);
+  TCALL(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
+  TCALL(mpmc_sim_step(sim, 0.3 * dt));
+  TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+  v[2 * 11 + 1] = 90.0;
+  TCALL(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
+  TCALL(mpmc_sim_stable_dt(sim, 1.0, &dt));
+  if (!(dt <= H / (wave_speed() + 90.0))) fail_msg("v written and given back: limit %.17g ignores it", dt);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
 }
@@ -250,6 +304,7 @@ int main(void) {
       cmocka_unit_test(test_dt_refused),   cmocka_unit_test(test_energy_stop),
       cmocka_unit_test(test_no_false_stop), cmocka_unit_test(test_leaves_grid),
       cmocka_unit_test(test_nan_velocity), cmocka_unit_test(test_bad_factor),
+      cmocka_unit_test(test_limit_follows_v),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

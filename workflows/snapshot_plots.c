@@ -70,7 +70,7 @@ static int by_far(const void *a, const void *b) {
   return da < db ? 1 : da > db ? -1 : 0;
 }
 
-static int write_csv(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, const char *path, double t) {
+static int write_csv_fields(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, const char *path, double t) {
   int np, e;
   double *x, *x0, *v, *sig, *eps = NULL;
   mpmc_sim_get_num_particles(sim, &np);
@@ -117,6 +117,15 @@ static int write_csv(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, con
   }
   free(order);
   return fclose(f) ? MPMC_ERR_IO : 0;
+}
+
+/* write_csv_fields, the velocity given back after (a borrowed velocity makes the stability
+ * limit take a pass over the points: mpmc_sim_get_field) */
+static int write_csv(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, const char *path, double t) {
+  const int e = write_csv_fields(sim, sc, p, path, t);
+  double *v = NULL;
+  mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v);
+  return e;
 }
 
 /**

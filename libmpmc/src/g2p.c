@@ -74,7 +74,8 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
  * V^n and V^n J into fb (the grid's fb, pairs) with the weights of its own space
  * (transfer.h); either way the caller runs the points in slab colours. */
 MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, const int FB,
-                                 double dt, const g2p_ctx *c, double *restrict fb, int q) {
+                                 double dt, const g2p_ctx *c, double *restrict fb, int q,
+                                 double *v2max) {
   mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
@@ -158,12 +159,16 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   }
   double *v = p->v + qd;
   const double eta = c->eta, pic = 1.0 - eta; /* in registers: v and xout might alias c */
+  double v2 = 0.0; /* |v|^2 summed as stability.c's pass sums it */
   for (int a = 0; a < DIM; ++a) {
-    v[a] = eta * (v[a] + dv[a]) + pic * vpic[a];
+    const double va = eta * (v[a] + dv[a]) + pic * vpic[a];
+    v[a] = va;
+    v2 += va * va;
     const double xa = p->x[qd + a] + dt * vpic[a];
     c->xout[qd + a] = xa;
     ok &= (xa >= c->xmin[a]) & (xa <= c->xmax[a]);
   }
+  *v2max = v2 > *v2max ? v2 : *v2max; /* NaN skipped, as there */
   return ok;
 }
 
@@ -171,52 +176,58 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
  * the grid's fbj or a copy of it, in rows of four nodes with wide (fb_scatter); 2: the stable
  * form's, into fb or a copy) */
 MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS, int fb, int wide,
-                                   double dt, const g2p_ctx *c, double *restrict fbuf, int q) {
-  return fb == 2 ? g2p_point(sim, DIM, BASIS, 2, dt, c, fbuf, q)
-         : wide  ? g2p_point(sim, DIM, BASIS, 3, dt, c, fbuf, q)
-                 : g2p_point(sim, DIM, BASIS, 1, dt, c, fbuf, q);
+                                   double dt, const g2p_ctx *c, double *restrict fbuf, int q,
+                                   double *v2max) {
+  return fb == 2 ? g2p_point(sim, DIM, BASIS, 2, dt, c, fbuf, q, v2max)
+         : wide  ? g2p_point(sim, DIM, BASIS, 3, dt, c, fbuf, q, v2max)
+                 : g2p_point(sim, DIM, BASIS, 1, dt, c, fbuf, q, v2max);
 }
 
 /* Without F-bar the points run in index order, split evenly among the threads; with it by
  * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
  * fused scatter is race-free, or, when P2G scattered into one grid per thread, in P2G's
  * chunks, each thread scattering into its own copy of fb. */
-#define G2P_KERNEL(D, B)                                                                     \
-  static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad) {           \
-    int first_bad = INT_MAX;                                                                 \
-    _Pragma("omp parallel for schedule(static) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
-    for (int q = 0; q < sim->p.n; ++q)                                                       \
-      if (!g2p_point(sim, D, B, 0, dt, c, NULL, q) && q < first_bad) first_bad = q;          \
-    *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
-  }                                                                                          \
+#define G2P_KERNEL(D, B)                                                                      \
+  static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad, double *vm) { \
+    int first_bad = INT_MAX;                                                                  \
+    double v2m = 0.0;                                                                         \
+    _Pragma("omp parallel for schedule(static) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
+    for (int q = 0; q < sim->p.n; ++q)                                                        \
+      if (!g2p_point(sim, D, B, 0, dt, c, NULL, q, &v2m) && q < first_bad) first_bad = q;     \
+    *bad = first_bad == INT_MAX ? -1 : first_bad;                                             \
+    *vm = v2m;                                                                                \
+  }                                                                                           \
   static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, double *fbp, int nc, \
-                              int *bad) {                                                    \
-    const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
-    const int fb = sim->fbar == MPMC_FBAR_STABLE ? 2 : 1;                                    \
-    double *fb0 = fb == 2 ? sim->grid.fb : sim->grid.fbj;                                    \
-    int first_bad = INT_MAX;                                                                 \
-    if (fbp) { /* P2G's chunks, each scattering into its own copy (p2g.c) */                 \
-      const size_t per = sim->grid.nn * (size_t)fb;                                          \
-      _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) num_threads(nc)") \
-      for (int t = 0; t < nc; ++t) {                                                         \
-        double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                  \
-        const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                               \
-        for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1_; ++k)                        \
-          if (!g2pfb_point(sim, D, B, fb, 0, dt, c, f_, order[k]) && order[k] < first_bad)   \
-            first_bad = order[k];                                                            \
-      }                                                                                      \
-      *bad = first_bad == INT_MAX ? -1 : first_bad;                                          \
-      return;                                                                                \
-    }                                                                                        \
-    const int wide = sim->slab_axis != 0; /* rows along x lie within a slab */               \
-    for (int colour = 0; colour < 2; ++colour) {                                             \
-      _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) if (sim->p.n > MPMC_OMP_MIN)") \
-      for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
-        for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
-          if (!g2pfb_point(sim, D, B, fb, wide, dt, c, fb0, order[k]) && order[k] < first_bad) \
-            first_bad = order[k];                                                            \
-    }                                                                                        \
-    *bad = first_bad == INT_MAX ? -1 : first_bad;                                            \
+                              int *bad, double *vm) {                                         \
+    const int *restrict order = sim->order, *restrict start = sim->slab_start;                \
+    const int fb = sim->fbar == MPMC_FBAR_STABLE ? 2 : 1;                                     \
+    double *fb0 = fb == 2 ? sim->grid.fb : sim->grid.fbj;                                     \
+    int first_bad = INT_MAX;                                                                  \
+    double v2m = 0.0;                                                                         \
+    if (fbp) { /* P2G's chunks, each scattering into its own copy (p2g.c) */                  \
+      const size_t per = sim->grid.nn * (size_t)fb;                                           \
+      _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) reduction(max : v2m) num_threads(nc)") \
+      for (int t = 0; t < nc; ++t) {                                                          \
+        double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                   \
+        const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                                \
+        for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1_; ++k)                         \
+          if (!g2pfb_point(sim, D, B, fb, 0, dt, c, f_, order[k], &v2m) && order[k] < first_bad) \
+            first_bad = order[k];                                                             \
+      }                                                                                       \
+      *bad = first_bad == INT_MAX ? -1 : first_bad;                                           \
+      *vm = v2m;                                                                                \
+      return;                                                                                 \
+    }                                                                                         \
+    const int wide = sim->slab_axis != 0; /* rows along x lie within a slab */                \
+    for (int colour = 0; colour < 2; ++colour) {                                              \
+      _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
+      for (int sl = colour; sl < sim->nslab; sl += 2)                                         \
+        for (int k = start[sl]; k < start[sl + 1]; ++k)                                       \
+          if (!g2pfb_point(sim, D, B, fb, wide, dt, c, fb0, order[k], &v2m) && order[k] < first_bad) \
+            first_bad = order[k];                                                             \
+    }                                                                                         \
+    *bad = first_bad == INT_MAX ? -1 : first_bad;                                             \
+    *vm = v2m;                                                                                \
   }
 MPMC_KERNELS(G2P_KERNEL)
 
@@ -248,16 +259,20 @@ int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
     c.xmax[a] = g->hi[a] + g->h;
   }
   int bad = -1;
+  double v2max = 0.0;
   if (sim->fbar && g->fbj) { /* fb and fbj are zero (mpmc_grid_clear_active) */
     mpmc_grid *gw = &sim->grid;
     const int nc = gw->nprivate, width = sim->fbar == MPMC_FBAR_STABLE ? 2 : 1;
     double *fbp = nc ? mpmc_grid_copies(gw, &gw->fbpriv, &gw->cap_fbpriv, width, nc - 1) : NULL;
-    MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, fbp, nc, &bad);
+    MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, fbp, nc, &bad, &v2max);
     if (fbp) mpmc_grid_add_copies(gw, width == 2 ? gw->fb : gw->fbj, fbp, width, nc - 1);
     gw->fb_done = 1;
   } else {
-    MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad);
+    MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad, &v2max);
   }
+  /* the stability limit's max |v|^2 (stability.c), unless v is on loan to a caller */
+  sim->v2max = v2max;
+  sim->v2max_ok = bad < 0 && !sim->v_borrowed;
   if (bad >= 0) return report(sim, bad);
   return MPMC_SUCCESS;
 }

@@ -396,7 +396,8 @@ static const char *field_names[MPMC_FIELD_COUNT] = {
 /**
  * @brief Borrow a particle field in place (no copy).  Layout [n][ncomp].
  * Optional fields are created by the first step (or mpmc_sim_get_field after it):
- * a field the scene does not have is MPMC_ERR_STATE.
+ * a field the scene does not have is MPMC_ERR_STATE.  A borrowed velocity may be written:
+ * until it is given back (mpmc_sim_restore_field) the stability limit recomputes max |v|.
  */
 int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   if (!sim) return MPMC_ERR_ARG;
@@ -406,6 +407,7 @@ int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   MPMC_CHECK(f, sim->ctx, MPMC_ERR_ARG, "field = %d is not a particle field", field);
   if (!*f && sim->grid.valid) MPMC_CALL(mpmc_sim_prepare(sim));
   MPMC_CHECK(*f, sim->ctx, MPMC_ERR_STATE, "this simulation has no '%s' field", field_names[field]);
+  if (field == MPMC_FIELD_VELOCITY) sim->v_borrowed = 1; /* G2P's max |v| no longer holds */
   *data = *f;
   if (ncomp) *ncomp = nc;
   return MPMC_SUCCESS;
@@ -417,6 +419,10 @@ int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data) {
   MPMC_CHECK(field >= 0 && field < MPMC_FIELD_COUNT, sim->ctx, MPMC_ERR_ARG,
              "field = %d is not a particle field", field);
   if (data) *data = NULL;
+  if (field == MPMC_FIELD_VELOCITY) { /* the caller may have written v: a pass until G2P's next */
+    sim->v_borrowed = 0;
+    sim->v2max_ok = 0;
+  }
   return MPMC_SUCCESS;
 }
 

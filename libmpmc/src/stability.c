@@ -17,11 +17,15 @@ double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
     }
   }
   double vmax = 0.0;
+  if (sim->v2max_ok && !sim->v_borrowed) {
+    vmax = sim->v2max; /* G2P's, the same sums (g2p.c) */
+  } else {
 #pragma omp parallel for reduction(max : vmax) schedule(static) if (p->n > MPMC_OMP_MIN)
-  for (int q = 0; q < p->n; ++q) {
-    double v2 = 0.0;
-    for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];
-    if (v2 > vmax) vmax = v2;
+    for (int q = 0; q < p->n; ++q) {
+      double v2 = 0.0;
+      for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];
+      if (v2 > vmax) vmax = v2;
+    }
   }
   vmax = sqrt(vmax);
   double dt = cmax + vmax > 0 ? sim->grid.h / (cmax + vmax) : INFINITY;
