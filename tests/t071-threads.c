@@ -18,8 +18,6 @@
 
 #include "test_util.h"
 
-static void check_axis_rule(void);
-
 typedef struct {
   int n;
   double *x, *v, *s, *J;
@@ -123,9 +121,7 @@ static void test_3d_compact(void **state) {
  * plane: a permutation, slabs in plane order, every point in its own slab's planes, and within
  * a slab the points by plane and within a plane in index order (points stored at random).
  * The order does not depend on how the points were split among the threads (one thread gives
- * the same permutation), nor on the axis the build started from (the last step's): the
- * 16 x 7 x 8-cell block slabs along x for two threads, the only axis whose slabs split
- * evenly (z: 3 + 3 + 2 planes, y: 3 + 3 + 1). */
+ * the same permutation), nor on the axis the build started from (the last step's). */
 static void test_slab_order(void **state) {
   (void)state;
   mpmc_context ctx;
@@ -133,7 +129,6 @@ static void test_slab_order(void **state) {
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
   TCALL(mpmc_sim_create(ctx, 3, &sim));
-  TCALL(mpmc_sim_set_threads(sim, 2)); /* the axis for two threads, also when one builds */
   const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1}, bhi[3] = {1.6, 0.7, 0.8};
   TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
   int mat, n;
@@ -190,49 +185,14 @@ static void test_slab_order(void **state) {
       fail_msg("order[%d] = %d on one thread, %d on %d", k, sim->order[k], first[k], saved);
   free(first);
   free(seen);
-  check_axis_rule();
+  /* the axis rule: z once the points span MPMC_SLAB_PLANES planes along it (the landslide:
+   * 275 cells long, 30 high), else the longest extent (y and x in 2D likewise) */
+  const int clo[3] = {0, 0, 0}, tall[3] = {274, 24, MPMC_SLAB_PLANES - 1}, flat[3] = {274, 24, MPMC_SLAB_PLANES - 2};
+  if (mpmc_slab_axis(3, clo, tall) != 2) fail_msg("slab axis %d for %d z planes, expected 2", mpmc_slab_axis(3, clo, tall), MPMC_SLAB_PLANES);
+  if (mpmc_slab_axis(3, clo, flat) != 0) fail_msg("slab axis %d for %d z planes, expected 0", mpmc_slab_axis(3, clo, flat), MPMC_SLAB_PLANES - 1);
+  if (mpmc_slab_axis(2, clo, tall) != 1) fail_msg("2D: slab axis %d for 25 y planes, expected 1", mpmc_slab_axis(2, clo, tall));
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
-}
-
-/* points spread over np planes: uniformly, or with the share bottom of them in the first 3 */
-static void spread(int *h, int np, int n, double bottom) {
-  int left = n;
-  for (int k = 0; k < np; ++k) {
-    const int c = bottom > 0 ? (k < 3 ? (int)(bottom * n / 3) : (int)((1 - bottom) * n / (np - 3))) : n / np;
-    h[k] = k == np - 1 ? left : c;
-    left -= h[k];
-  }
-}
-
-/* The axis rule (mpmc_slab_axis_pick), with what the slabs of each axis would do by hand:
- * - the landslide late in its run-out (x 275 planes, y 25, z 30 with 37 % of the points in
- *   the lowest 3): z slabs of >= 3 planes put 37 % in one slab, a thread's 25 % share
- *   overrun, y slabs are even: y;
- * - z 48 and y 24 even planes: both split exactly (16 and 8 slabs of 3 planes): z, the
- *   outermost; but y when y was the last step's axis (it does as well);
- * - y and z 4 planes each, x 100: y's slabs are 3 + 1 planes, 75 % of a colour on one
- *   thread (half busy); x even (0.9 for its memory order): x;
- * - one thread: every axis keeps it busy: z (y in 2D). */
-static void check_axis_rule(void) {
-  enum { N = 240000 };
-  static int hx[300], hy[300], hz[300];
-  const int lo[3] = {0, 0, 0};
-  const int *h[3] = {hx, hy, hz};
-  spread(hx, 275, N, 0), spread(hy, 25, N, 0), spread(hz, 30, N, 0.37);
-  int hi[3] = {274, 24, 29};
-  int ax = mpmc_slab_axis_pick(3, 2, N, lo, hi, h, 2);
-  if (ax != 1) fail_msg("landslide run-out: slab axis %d, expected 1 (y)", ax);
-  if ((ax = mpmc_slab_axis_pick(3, 1, N, lo, hi, h, -1)) != 2) fail_msg("one thread: slab axis %d, expected 2", ax);
-  spread(hy, 24, N, 0), spread(hz, 48, N, 0);
-  hi[1] = 23, hi[2] = 47;
-  if ((ax = mpmc_slab_axis_pick(3, 2, N, lo, hi, h, -1)) != 2) fail_msg("even y and z: slab axis %d, expected 2", ax);
-  if ((ax = mpmc_slab_axis_pick(3, 2, N, lo, hi, h, 1)) != 1) fail_msg("even y and z after y: slab axis %d, expected 1", ax);
-  spread(hx, 100, N, 0), spread(hy, 4, N, 0), spread(hz, 4, N, 0);
-  hi[0] = 99, hi[1] = 3, hi[2] = 3;
-  if ((ax = mpmc_slab_axis_pick(3, 2, N, lo, hi, h, 2)) != 0) fail_msg("thin in y and z: slab axis %d, expected 0", ax);
-  if ((ax = mpmc_slab_axis_pick(2, 2, N, lo, hi, h, -1)) != 0) fail_msg("2D, thin in y: slab axis %d, expected 0", ax);
-  if ((ax = mpmc_slab_axis_pick(2, 1, N, lo, hi, h, 0)) != 1) fail_msg("2D, one thread: slab axis %d, expected 1", ax);
 }
 
 int main(void) {

@@ -108,7 +108,7 @@ static int read_config(hid_t f, mpmc_sim sim) {
   int64_t sort[2] = {0, -1}; /* absent in files of before the sort: never sorted */
   if (H5Aexists(g, "sort_interval_last") > 0)
     st |= mpmc_h5_attr_read(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
-  int axes[2] = {-1, -1}; /* absent in files of before: no sort for an axis change until the next */
+  int axes[2] = {-1, 0}; /* absent in files of before: no sort for an axis change until the next */
   if (H5Aexists(g, "sort_axis_slab_axis") > 0)
     st |= mpmc_h5_attr_read(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
   H5Gclose(g);
@@ -140,7 +140,7 @@ static int read_config(hid_t f, mpmc_sim sim) {
              (long long)sort[0], (long long)sort[1]);
   sim->sort_every = (int)sort[0];
   sim->sort_last = sort[1];
-  MPMC_CHECK(axes[0] >= -1 && axes[0] < sim->dim && axes[1] >= -1 && axes[1] < sim->dim, ctx,
+  MPMC_CHECK(axes[0] >= -1 && axes[0] < sim->dim && axes[1] >= 0 && axes[1] < sim->dim, ctx,
              MPMC_ERR_FORMAT, "checkpoint /config: bad sort_axis_slab_axis = [%d, %d]", axes[0], axes[1]);
   sim->sort_axis = axes[0];
   sim->slab_axis = axes[1];

@@ -301,28 +301,24 @@ struct mpmc_sim_s {
 /* Chunk t of nc consecutive chunks of [0, n): the first index; chunk t ends where t + 1
  * begins (the slab build, and P2G's and G2P's per-thread grids, split the points so) */
 static inline int mpmc_chunk_start(int n, int t, int nc) { return (int)((long long)n * t / nc); }
-/* Slabs along an axis of np cell planes holding n points, for nt threads: a slab closes once
- * it is MPMC_SLAB_W planes wide and the slabs so far hold share (ns + 1) points, share =
- * mpmc_slab_share (so that each colour's slabs split evenly among the threads where the
- * points allow), or at the last plane. */
-static inline double mpmc_slab_share(int n, int nt, int np) {
-  const int per = np / (MPMC_SLAB_W * 2 * nt);
-  return (double)n / (2 * nt * (per < 1 ? 1 : per));
+/* The slab axis for points whose cells span [clo, chi] per axis: the outermost axis of the
+ * grid's memory (z in 3D, y in 2D) when the points span MPMC_SLAB_PLANES cell planes along
+ * it, else the longest extent, ties to the outermost.  p2g.c slabs along it and sort.c puts it
+ * outermost in its key, so the innermost sort axis, along which consecutive points follow
+ * one another, is x, the axis along which node records are contiguous whenever x is not the
+ * slab axis: with x as slab axis (the landslide's, 55 m long) consecutive points stepped
+ * along y, a row of records (18 kB) apart, and G2P took a quarter longer.  24 planes make
+ * eight slabs of three planes or more for two threads, four per colour (p2g.c balances the
+ * points among them). */
+#define MPMC_SLAB_PLANES 24
+static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
+  if (chi[dim - 1] - clo[dim - 1] + 1 >= MPMC_SLAB_PLANES) return dim - 1;
+  int ax = dim - 1;
+  for (int a = dim - 2; a >= 0; --a)
+    if (chi[a] - clo[a] > chi[ax] - clo[ax]) ax = a;
+  return ax;
 }
-static inline int mpmc_slab_closes(int width, int sum, double share, int ns, int last) {
-  return last || (width >= MPMC_SLAB_W && sum >= share * (ns + 1));
-}
-/* The slab axis (p2g.c) for n points in the cells [clo, chi] with hist[a][c] points in cell
- * plane c along axis a, on nt threads (sort.c; the sort puts it outermost).  Each axis is
- * scored by how evenly its slabs keep the threads busy, the two colours each run as OpenMP's
- * dynamic schedule would hand the slabs out; x, along which node records are contiguous,
- * scores 0.9 of that (as the slab axis it makes consecutive points step across rows: G2P a
- * quarter slower on the landslide), and ties go to the outermost axis.  The last step's axis
- * prev stays while it scores within 2 % of the best. */
-int mpmc_slab_axis_pick(int dim, int nt, int n, const int *clo, const int *chi,
-                        const int *const *hist, int prev);
-/* the thread count of a sim's parallel regions */
-int mpmc_sim_nthreads(const struct mpmc_sim_s *sim);
+
 /* The step's kernel phases (p2g.c, grid_update.c, g2p.c, fbar.c) exist once per instruction
  * set: CMakeLists.txt compiles these four files a second time for x86-64-v3 (AVX2) with
  * MPMC_ISA_AVX2 defined, which appends _avx2 to their external names.  A sim runs one set

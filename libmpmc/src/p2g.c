@@ -25,15 +25,10 @@
  * idle for a third of P2G in the 3D column).  Results depend on the thread count only
  * through the summation order at the nodes that two slabs share (at every node when the
  * threads scatter into grids of their own, private_grids).
- * The slab axis is the one whose slabs keep the threads busiest (mpmc_slab_axis_pick, which
- * prefers y or z to x and keeps the last step's while it does about as well): in a run-out
- * the deposit thins until its lowest three cell planes along z hold a third of the points,
- * and z slabs then left a thread idle for a fifth of P2G and G2P, where slabs across the
- * width are even.
  * Both passes over the points run on all threads, each over a fixed chunk of them: the
- * first finds the box and counts the points per cell plane along every axis (per plane of
- * the last step's axis in runs; counted again in the rare step where the counts call for
- * another axis), the second places them.  Each point's plane is kept in between in dF, which is free from the
+ * first finds the box and counts the points per plane of the slab axis (the last step's
+ * axis; counted again in the rare step where mpmc_slab_axis picks another for the box), the
+ * second places them.  Each point's plane is kept in between in dF, which is free from the
  * end of one step's material update until its G2P (sort.c uses it likewise).  The order
  * does not depend on the chunks, so neither on the thread count. */
 int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
@@ -59,31 +54,29 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   const int nt = 1;
 #endif
   const int nc = n > MPMC_OMP_MIN ? nt : 1; /* chunks */
-  /* counts per chunk and plane of every axis, [nc][ntot] (axis a's planes from off[a]), then
-   * along the slab axis the chunks' fill positions; the chunks' boxes [nc][6]; the counts of
-   * all chunks [ntot] */
-  int off[3] = {0, 0, 0}, ntot = 0;
-  for (int a = 0; a < d; ++a) off[a] = ntot, ntot += g->n[a];
-  const size_t need = (size_t)(nc + 1) * (size_t)ntot + 6 * (size_t)nc;
+  int nmax = 1;
+  for (int a = 0; a < d; ++a) nmax = g->n[a] > nmax ? g->n[a] : nmax;
+  /* counts per chunk and plane, [nc][nmax], then the chunks' fill positions; the chunks'
+   * boxes [nc][6] */
+  const size_t need = (size_t)nc * (size_t)nmax + 6 * (size_t)nc;
   if (need > g->cap_ccount) {
     int *c = realloc(g->ccount, sizeof(int) * need);
     MPMC_CHECK(c, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %zu plane counts", need);
     g->ccount = c;
     g->cap_ccount = need;
   }
-  int *cnt = g->ccount, *box = cnt + (size_t)nc * ntot, *all = box + 6 * (size_t)nc;
+  int *cnt = g->ccount, *box = cnt + (size_t)nc * nmax;
   int *plane = (int *)(void *)p->dF;
   int clo[3] = {0, 0, 0}, chi[3] = {0, 0, 0};
-  const int prev = sim->slab_axis >= 0 && sim->slab_axis < d ? sim->slab_axis : -1;
-  int ax = prev >= 0 ? prev : d - 1;
+  int ax = sim->slab_axis >= 0 && sim->slab_axis < d ? sim->slab_axis : d - 1;
   for (int pass = 0; pass < 2; ++pass) {
     /* the cells holding points (the points stay within one cell of the box, g2p checks, well
      * inside the ghost layers, so the cell coordinates are positive) and the plane counts */
 #pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
     for (int t = 0; t < nc; ++t) {
       int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
-      int *ct = cnt + (size_t)t * ntot, *cax = ct + off[ax];
-      for (int k = 0; k < ntot; ++k) ct[k] = 0;
+      int *ct = cnt + (size_t)t * nmax;
+      for (int k = 0; k < nmax; ++k) ct[k] = 0;
       const int q0 = mpmc_chunk_start(n, t, nc), q1 = mpmc_chunk_start(n, t + 1, nc);
       int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
       for (int q = q0; q < q1; ++q) {
@@ -95,17 +88,15 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
           if (a == ax) {
             plane[q] = c;
             if (c != cur) {
-              if (run) cax[cur] += run;
+              if (run) ct[cur] += run;
               cur = c;
               run = 0;
             }
             ++run;
-          } else {
-            ++ct[off[a] + c]; /* for the choice of the axis */
           }
         }
       }
-      if (run) cax[cur] += run;
+      if (run) ct[cur] += run;
       for (int a = 0; a < 3; ++a) {
         box[6 * t + a] = lo[a];
         box[6 * t + 3 + a] = hi[a];
@@ -119,18 +110,9 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
         chi[a] = box[6 * t + 3 + a] > chi[a] ? box[6 * t + 3 + a] : chi[a];
       }
     }
-    const int *hist[3] = {cnt + off[0], cnt + off[1], cnt + off[2]};
-    if (nc > 1) {
-      for (int k = 0; k < ntot; ++k) {
-        int s = 0;
-        for (int t = 0; t < nc; ++t) s += cnt[(size_t)t * ntot + k];
-        all[k] = s;
-      }
-      for (int a = 0; a < d; ++a) hist[a] = all + off[a];
-    }
-    const int best = mpmc_slab_axis_pick(d, mpmc_sim_nthreads(sim), n, clo, chi, hist, prev);
-    if (best == ax || pass == 1) break;
-    ax = best; /* the points call for another axis: count along that one */
+    const int best = mpmc_slab_axis(d, clo, chi);
+    if (best == ax) break;
+    ax = best; /* the box calls for another axis: count along that one */
   }
   for (int a = 0; a < 3; ++a) {
     const int lo = a < d ? clo[a] - 1 : 0, hi = a < d ? chi[a] + 3 : 1;
@@ -138,7 +120,8 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     g->act_hi[a] = hi > g->n[a] ? g->n[a] : hi;
   }
   const int np = chi[ax] - clo[ax] + 1; /* planes */
-  const double share = mpmc_slab_share(n, nt, np);
+  const int per = np / (MPMC_SLAB_W * 2 * nt);
+  const double share = (double)n / (2 * nt * (per < 1 ? 1 : per));
   const int cap = np / MPMC_SLAB_W + 2;
   if (cap > sim->cap_slab) {
     int *st = realloc(sim->slab_start, sizeof(int) * (size_t)cap);
@@ -154,13 +137,13 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   start[0] = 0;
   for (int pl = clo[ax]; pl <= chi[ax]; ++pl) {
     for (int t = 0; t < nc; ++t) {
-      int *c = cnt + (size_t)t * ntot + off[ax] + pl;
+      int *c = cnt + (size_t)t * nmax + pl;
       const int k = *c;
       *c = sum;
       sum += k;
     }
     ++width;
-    if (mpmc_slab_closes(width, sum, share, ns, pl == chi[ax])) {
+    if (pl == chi[ax] || (width >= MPMC_SLAB_W && sum >= share * (ns + 1))) {
       start[++ns] = sum;
       width = 0;
     }
@@ -168,7 +151,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   int *order = sim->order;
 #pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
   for (int t = 0; t < nc; ++t) {
-    int *fill = cnt + (size_t)t * ntot + off[ax];
+    int *fill = cnt + (size_t)t * nmax;
     const int q0 = mpmc_chunk_start(n, t, nc), q1 = mpmc_chunk_start(n, t + 1, nc);
     if (q0 >= q1) continue; /* more threads than points to share */
     int cur = plane[q0], pos = fill[cur];

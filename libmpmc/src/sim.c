@@ -76,7 +76,6 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
   s->solver = MPMC_SOLVER_AUTO;
   s->sort_last = -1;
   s->sort_axis = -1;
-  s->slab_axis = -1; /* none built yet */
   s->p.dim = dim;
   const int err = kernels_from_env(s);
   if (err) {

@@ -5,8 +5,9 @@
  * stencils hit the same cache lines of the grid, and the slab order reads the particle
  * arrays in runs instead of at random.  As a run goes on, points flow away from where they
  * were seeded and the store loses that order; mpmc_sim_sort_particles restores it by a
- * stable counting sort on the cell, with the slab axis (mpmc_slab_axis_pick, below: the axis
- * whose slabs keep the threads busiest, y or z before x; as p2g.c picks it) outermost and the others in the grid's memory order, so that a slab is one contiguous run
+ * stable counting sort on the cell, with the slab axis (mpmc_slab_axis: z, or y in 2D, when
+ * the points span enough cell planes along it, else their longest extent; as p2g.c picks it)
+ * outermost and the others in the grid's memory order, so that a slab is one contiguous run
  * of points and consecutive points mostly step along x, where node records are contiguous;
  * within a cell the points go by the half of the cell they lie in along each axis, the same
  * order in every cell (the kernels' branches then repeat).
@@ -22,10 +23,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "contact.h"
 #include "mpmc_impl.h"
@@ -56,58 +53,6 @@ static void permute_doubles(double *a, int nc, const int *perm, int n, double *t
   }
 }
 
-/* The time the slabs along one axis keep nt threads busy, in points: per colour the slabs in
- * order, each to the thread that is free first (OpenMP's dynamic schedule, points of equal
- * cost), the colour lasting as long as its busiest thread. */
-static double slab_busy(int nt, int n, int lo, int hi, const int *hist) {
-  enum { MAXT = 64 };
-  const int t = nt < 1 ? 1 : nt > MAXT ? MAXT : nt;
-  const double share = mpmc_slab_share(n, t, hi - lo + 1);
-  double load[2][MAXT] = {{0}};
-  int ns = 0, width = 0, sum = 0, begin = 0;
-  for (int pl = lo; pl <= hi; ++pl) {
-    sum += hist[pl];
-    ++width;
-    if (mpmc_slab_closes(width, sum, share, ns, pl == hi)) {
-      double *l = load[ns % 2];
-      int free = 0;
-      for (int k = 1; k < t; ++k) free = l[k] < l[free] ? k : free;
-      l[free] += sum - begin;
-      begin = sum;
-      width = 0;
-      ++ns;
-    }
-  }
-  double span = 0.0;
-  for (int c = 0; c < 2; ++c) {
-    double m = 0.0;
-    for (int k = 0; k < t; ++k) m = load[c][k] > m ? load[c][k] : m;
-    span += m;
-  }
-  return n / (t * span); /* 1: the threads never wait */
-}
-
-int mpmc_slab_axis_pick(int dim, int nt, int n, const int *clo, const int *chi,
-                        const int *const *hist, int prev) {
-  if (n <= 0) return prev >= 0 && prev < dim ? prev : dim - 1;
-  double score[3] = {0, 0, 0};
-  int best = dim - 1;
-  for (int a = dim - 1; a >= 0; --a) {
-    score[a] = slab_busy(nt, n, clo[a], chi[a], hist[a]) * (a == 0 && dim > 1 ? 0.9 : 1.0);
-    if (score[a] > score[best]) best = a;
-  }
-  return prev >= 0 && prev < dim && score[prev] >= 0.98 * score[best] ? prev : best;
-}
-
-int mpmc_sim_nthreads(const struct mpmc_sim_s *sim) {
-#ifdef _OPENMP
-  return sim->nthreads > 0 ? sim->nthreads : omp_get_max_threads();
-#else
-  (void)sim;
-  return 1;
-#endif
-}
-
 static void permute_ints(int *a, const int *perm, int n, double *tmp) {
   for (int i = 0; i < n; ++i) tmp[i] = (double)a[perm[i]];
   for (int i = 0; i < n; ++i) a[i] = (int)tmp[i];
@@ -118,8 +63,7 @@ static void permute_ints(int *a, const int *perm, int n, double *tmp) {
  * The halves order the points of a cell alike in every cell, so the kernels' branches (the
  * B-spline stencil starts at the cell below or at the cell itself, uGIMP's four cases) repeat
  * from cell to cell and predict well. */
-static int point_keys(const mpmc_sim sim, double *key, double *half, int *clo, int *chi,
-                      int *const *hist) {
+static int point_keys(const mpmc_sim sim, double *key, double *half, int *clo, int *chi) {
   const mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim, n = p->n;
@@ -136,12 +80,10 @@ static int point_keys(const mpmc_sim sim, double *key, double *half, int *clo, i
       CELL_OF(q, a, s, c);
       clo[a] = c < clo[a] ? c : clo[a];
       chi[a] = c > chi[a] ? c : chi[a];
-      ++hist[a][c];
     }
-  /* axis order, most significant first: the slab axis (P2G's, from the same counts), then
-   * the others from the outermost in */
-  const int ax = mpmc_slab_axis_pick(d, mpmc_sim_nthreads(sim), n, clo, chi,
-                                     (const int *const *)hist, sim->slab_axis);
+  /* axis order, most significant first: the slab axis (P2G's), then the others from the
+   * outermost in */
+  const int ax = mpmc_slab_axis(d, clo, chi);
   int ord[3], k = 0;
   ord[k++] = ax;
   for (int a = d - 1; a >= 0; --a)
@@ -202,15 +144,7 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
   int *perm = sim->order;
   int clo[3], chi[3];
   double *key = tmp, *half = tmp + n, *first = tmp + 2 * (size_t)n; /* w >= 3 columns */
-  int *hist[3] = {NULL, NULL, NULL}; /* points per cell plane along each axis */
-  int *hbuf = calloc((size_t)sim->grid.n[0] + sim->grid.n[1] + sim->grid.n[2], sizeof *hbuf);
-  if (!hbuf) {
-    free(own);
-    return MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "sort: cannot allocate the plane counts");
-  }
-  for (int a = 0, off = 0; a < d; off += sim->grid.n[a++]) hist[a] = hbuf + off;
-  sim->sort_axis = point_keys(sim, key, half, clo, chi, hist);
-  free(hbuf);
+  sim->sort_axis = point_keys(sim, key, half, clo, chi);
   size_t ncell = 1;
   for (int a = 0; a < d; ++a) ncell *= (size_t)(chi[a] - clo[a] + 1);
   int *cnt = calloc(ncell + 1, sizeof *cnt);
@@ -300,10 +234,9 @@ int mpmc_sort_due(mpmc_sim sim) {
   if (sim->sort_every <= 0) return MPMC_SUCCESS;
   const int64_t since = sim->stats.steps - sim->sort_last;
   /* also soon after the slab axis changed (the last step's slab build chose another than the
-   * sort's, as a collapsing body gets flatter), or is not known (a checkpoint of before the
-   * axes were kept): the storage order then need not follow the slabs; at most one such sort
-   * per tenth of the interval, should the axis go back and forth */
-  const int flip = sim->slab_axis >= 0 && sim->slab_axis != sim->sort_axis &&
+   * sort's, as a collapsing body gets flatter): the storage order then no longer follows the
+   * slabs; at most one such sort per tenth of the interval, should the axis go back and forth */
+  const int flip = sim->sort_axis >= 0 && sim->slab_axis != sim->sort_axis &&
                    since >= (sim->sort_every + 9) / 10;
   if (sim->sort_last >= 0 && since < sim->sort_every && !flip) return MPMC_SUCCESS;
   return mpmc_sim_sort_particles(sim);
