@@ -3,7 +3,9 @@
  * to point is replaced by its volume average.  The stable form (a space one order below the
  * basis) also removes the mode of period 2h, J = 1 + e sum_a cos(pi x_a / h), exactly, which
  * the projection onto the basis itself (total form) passes at a large share of its amplitude:
- * the pressure checkerboard of the strip footing (docs/theory.md). */
+ * the pressure checkerboard of the strip footing (docs/theory.md).  A caller that borrows the
+ * positions once and keeps the pointer across F-bar steps (a legacy Fortran loop) reads the
+ * current positions through it, the same bits as a run that borrows them afresh. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -191,6 +193,51 @@ static void test_nodal_mode(void **state) {
  * is zero (fb, allocated for the stable form alone, fbj and the records' volume slot): every
  * form's supports, the stable form's spaces too, lie in the active box.  A block translating
  * through the grid, every form, basis and dimension, after each step. */
+/* a 2D block falling with F-bar (every form), uGIMP; positions_held: borrowed once and kept */
+static mpmc_sim falling(mpmc_context ctx, int form, int *n) {
+  mpmc_sim sim;
+  TCALL(mpmc_sim_create(ctx, 2, &sim));
+  const double lo[2] = {0, 0}, hi[2] = {2, 2}, blo[2] = {0.5, 0.5}, bhi[2] = {1.25, 1.25}, g[2] = {0.3, -10};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.25));
+  TCALL(mpmc_sim_set_basis(sim, MPMC_BASIS_UGIMP));
+  TCALL(mpmc_sim_set_fbar(sim, form));
+  int mat;
+  TCALL(mpmc_sim_add_material_hencky(sim, 1e6, 0.45, 1000, &mat));
+  TCALL(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, n));
+  TCALL(mpmc_sim_set_gravity(sim, g));
+  return sim;
+}
+
+static void test_positions_held(void **state) {
+  (void)state;
+  for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_STABLE; ++form) {
+    mpmc_context ctx;
+    TCALL(mpmc_context_create(&ctx));
+    test_ctx = ctx;
+    int n;
+    mpmc_sim a = falling(ctx, form, &n), b = falling(ctx, form, &n);
+    double *held, *now, *xb;
+    TCALL(mpmc_sim_get_field(a, MPMC_FIELD_POSITION, &held, NULL));
+    const double y0 = held[1];
+    for (int s = 0; s < 6; ++s) {
+      TCALL(mpmc_sim_step(a, 1e-3));
+      TCALL(mpmc_sim_step(b, 1e-3));
+      TCALL(mpmc_sim_get_field(a, MPMC_FIELD_POSITION, &now, NULL));
+      if (now != held) fail_msg("form %d step %d: the positions moved to another array", form, s);
+      TCALL(mpmc_sim_get_field(b, MPMC_FIELD_POSITION, &xb, NULL));
+      for (int k = 0; k < 2 * n; ++k)
+        if (held[k] != xb[k])
+          fail_msg("form %d step %d: held position %d is %.17g, the run that borrows afresh has %.17g", form, s, k,
+                   held[k], xb[k]);
+      TCALL(mpmc_sim_restore_field(b, MPMC_FIELD_POSITION, &xb));
+    }
+    if (!(held[1] < y0 - 1e-4)) fail_msg("form %d: the block did not fall (y %.9g from %.9g)", form, held[1], y0);
+    mpmc_sim_destroy(&a);
+    mpmc_sim_destroy(&b);
+    mpmc_context_destroy(&ctx);
+  }
+}
+
 static void test_fb_cleared(void **state) {
   (void)state;
   for (int dim = 2; dim <= 3; ++dim)
@@ -321,6 +368,7 @@ int main(void) {
       cmocka_unit_test(test_nodal_mode),
       cmocka_unit_test(test_fb_cleared),
       cmocka_unit_test(test_deferred_gather),
+      cmocka_unit_test(test_positions_held),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

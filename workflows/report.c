@@ -19,6 +19,13 @@ const char *const wf_metric_names[WF_METRIC_COUNT] = {"runout_distance", "tip_di
                                                       [WF_METRIC_FRONT_X] = "surge_front_x",
                                                       [WF_METRIC_HYDRO] = "hydrostatic_pressure_error"};
 
+/* The positions given back after reading them: a position array on loan costs each F-bar
+ * step a copy (mpmc_sim_get_field). */
+static void give_back_x(mpmc_sim sim) {
+  double *x = NULL;
+  mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, &x);
+}
+
 /* Hydrostatic pressure error (dam break, paper section 4.3): with p = -tr(sigma)/3 and the
  * reference p_ref = rho g (surface - x_v) (rho = mass / initial volume, x_v the coordinate
  * along gravity), sqrt(sum (p - p_ref)^2 / sum p_ref^2) over the material points. */
@@ -47,6 +54,7 @@ int wf_metrics_stage_end(mpmc_sim sim, wf_scene *sc, int stage) {
   if (m->enabled[WF_METRIC_HYDRO] && m->hydro_stage == stage) {
     m->hydro_value = hydro_error(sim, sc);
     m->hydro_frozen = 1;
+    give_back_x(sim);
   }
   return 0;
 }
@@ -81,8 +89,7 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
   return 0;
 }
 
-/** @brief The enabled metrics of the current state. */
-int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *v) {
+static int metrics_of_fields(mpmc_sim sim, const wf_scene *sc, double *v) {
   const wf_metrics *m = &sc->metrics;
   double *x, *x0, *mass;
   int np, e;
@@ -122,6 +129,13 @@ int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *v) {
   if (m->enabled[WF_METRIC_BEARING]) /* rigid.c: q/su averaged since the last series row */
     wf_bearing_values(sc, 1, &v[WF_METRIC_SETTLEMENT_B], &v[WF_METRIC_Q_SU], &v[WF_METRIC_BEARING]);
   return 0;
+}
+
+/** @brief The enabled metrics of the current state. */
+int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *v) {
+  const int e = metrics_of_fields(sim, sc, v);
+  give_back_x(sim);
+  return e;
 }
 
 /* ---- progress ---------------------------------------------------------------------------- */

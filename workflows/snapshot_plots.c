@@ -119,12 +119,14 @@ static int write_csv_fields(mpmc_sim sim, const wf_scene *sc, const wf_snapplot 
   return fclose(f) ? MPMC_ERR_IO : 0;
 }
 
-/* write_csv_fields, the velocity given back after (a borrowed velocity makes the stability
- * limit take a pass over the points: mpmc_sim_get_field) */
+/* write_csv_fields, the velocity and positions given back after (on loan, the velocity makes
+ * the stability limit take a pass over the points, the positions cost each F-bar step a
+ * copy: mpmc_sim_get_field) */
 static int write_csv(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, const char *path, double t) {
   const int e = write_csv_fields(sim, sc, p, path, t);
-  double *v = NULL;
+  double *v = NULL, *x = NULL;
   mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v);
+  mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, &x);
   return e;
 }
 

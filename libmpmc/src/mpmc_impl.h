@@ -292,6 +292,9 @@ struct mpmc_sim_s {
    * (mpmc_sim_get_field, until mpmc_sim_restore_field) */
   double v2max;
   int v2max_ok, v_borrowed;
+  /* the position array as a caller borrowed it (mpmc_sim_get_field, until its restore):
+   * F-bar's phase swaps x and xn, so the step copies the new positions back into it */
+  double *x_lent;
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),
