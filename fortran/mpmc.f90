@@ -887,6 +887,9 @@ contains
   end function mpmc_context_last_error
 
   ! ---- zero-copy arrays -------------------------------------------------------------------
+  ! A field pointer stays the field across steps and sorts until points are added; give it
+  ! back with mpmc_sim_restore_field when done: on loan, the velocity makes each step's
+  ! stability limit take a pass over the points and, with F-bar, the positions a copy.
 
   function get_field_2d(sim, field, x) result(ierr)
     type(mpmc_sim), intent(in) :: sim
