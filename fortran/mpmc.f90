@@ -801,11 +801,13 @@ module mpmc
       integer(c_int), value :: flags
       integer(c_int) :: ierr
     end function
-    function mpmc_workflow_resume_c(ctx, outdir, flags) bind(C, name='mpmc_workflow_resume') &
-        result(ierr)
-      import :: c_int, c_char, mpmc_context
+    function mpmc_workflow_resume_set_c(ctx, outdir, noverride, overrides, flags) &
+        bind(C, name='mpmc_workflow_resume_set') result(ierr)
+      import :: c_int, c_char, c_ptr, mpmc_context
       type(mpmc_context), value :: ctx
       character(kind=c_char), intent(in) :: outdir(*)
+      integer(c_int), value :: noverride
+      type(c_ptr), intent(in) :: overrides(*)
       integer(c_int), value :: flags
       integer(c_int) :: ierr
     end function
@@ -1211,23 +1213,11 @@ contains
 #ifdef MPMC_HAVE_WORKFLOW
     character(kind=c_char), allocatable, target :: buf(:, :)
     type(c_ptr), allocatable :: ptrs(:)
-    integer :: i, j, n, l
+    integer :: n
     integer(c_int) :: f
     f = 0
     if (present(flags)) f = flags
-    n = 0
-    if (present(overrides)) n = size(overrides)
-    l = 1
-    if (n > 0) l = len(overrides) + 1
-    allocate (buf(l, max(n, 1)), ptrs(max(n, 1)))
-    buf = c_null_char
-    ptrs = c_null_ptr
-    do i = 1, n
-      do j = 1, len_trim(overrides(i))
-        buf(j, i) = overrides(i)(j:j)
-      end do
-      ptrs(i) = c_loc(buf(1, i))
-    end do
+    call c_strings(overrides, buf, ptrs, n)
     ierr = mpmc_workflow_run_c(ctx, mpmc_c_str(scene), mpmc_c_str(outdir), int(n, c_int), ptrs, f)
 #else
     ! Built without the workflow library (workflows/): there is nothing to run the scene.
@@ -1237,22 +1227,55 @@ contains
 #endif
   end function mpmc_workflow_run
 
-  !> Continue the run in outdir from its last checkpoint (`mpmc resume`); flags:
-  !> MPMC_WORKFLOW_QUIET.  MPMC_ERR_UNSUPPORTED without the workflow library.
-  function mpmc_workflow_resume(ctx, outdir, flags) result(ierr)
+  !> Continue the run in outdir from its last checkpoint (`mpmc resume`), a finished run once
+  !> its scene asks for more; overrides ("key.path=value") apply after the run's own, e.g.
+  !> 'stages.runout.end.time=8'; flags: MPMC_WORKFLOW_QUIET.  MPMC_ERR_UNSUPPORTED without
+  !> the workflow library.
+  function mpmc_workflow_resume(ctx, outdir, flags, overrides) result(ierr)
     type(mpmc_context), intent(in) :: ctx
     character(*), intent(in) :: outdir
     integer(c_int), intent(in), optional :: flags
+    character(*), intent(in), optional :: overrides(:)
     integer(c_int) :: ierr
 #ifdef MPMC_HAVE_WORKFLOW
+    character(kind=c_char), allocatable, target :: buf(:, :)
+    type(c_ptr), allocatable :: ptrs(:)
+    integer :: n
     integer(c_int) :: f
     f = 0
     if (present(flags)) f = flags
-    ierr = mpmc_workflow_resume_c(ctx, mpmc_c_str(outdir), f)
+    call c_strings(overrides, buf, ptrs, n)
+    ierr = mpmc_workflow_resume_set_c(ctx, mpmc_c_str(outdir), int(n, c_int), ptrs, f)
 #else
     ierr = MPMC_ERR_UNSUPPORTED
-    if (present(flags) .and. len(outdir) < 0 .and. c_associated(ctx%ptr)) ierr = MPMC_ERR_ARG
+    if (present(flags) .and. present(overrides) .and. len(outdir) < 0 .and. c_associated(ctx%ptr)) &
+      ierr = MPMC_ERR_ARG
 #endif
   end function mpmc_workflow_resume
+
+#ifdef MPMC_HAVE_WORKFLOW
+  ! NUL-terminated copies of the strings (trailing blanks dropped) in buf and their addresses
+  ! in ptrs, n of them (none when absent)
+  subroutine c_strings(strings, buf, ptrs, n)
+    character(*), intent(in), optional :: strings(:)
+    character(kind=c_char), allocatable, target, intent(out) :: buf(:, :)
+    type(c_ptr), allocatable, intent(out) :: ptrs(:)
+    integer, intent(out) :: n
+    integer :: i, j, l
+    n = 0
+    if (present(strings)) n = size(strings)
+    l = 1
+    if (n > 0) l = len(strings) + 1
+    allocate (buf(l, max(n, 1)), ptrs(max(n, 1)))
+    buf = c_null_char
+    ptrs = c_null_ptr
+    do i = 1, n
+      do j = 1, len_trim(strings(i))
+        buf(j, i) = strings(i)(j:j)
+      end do
+      ptrs(i) = c_loc(buf(1, i))
+    end do
+  end subroutine c_strings
+#endif
 
 end module mpmc

@@ -5,7 +5,9 @@
 ! relative (summary.json carries all 17 digits).
 ! The run is shortened with overrides (coarser grid, shorter stages, a gravity stage that
 ! ends on its kinetic-energy criterion, a toe inside the slope so that the distance is
-! positive after a short run).
+! positive after a short run).  Then the finished run goes on through mpmc_workflow_resume
+! with a later end for the run-out as an override: its stage then ends at that time, with
+! more steps.
 !
 !   t641-legacy-slope-f LEGACY_SLOPE SCENE OUTDIR
 program t641_legacy_slope_f
@@ -115,6 +117,33 @@ program t641_legacy_slope_f
     write (*, '(a,es24.16,a,es24.16,a,es10.2)') 'FAILED: run-out distance: expected ', wf_runout, &
       ' (mpmc run), got ', f_runout, ' (legacy_slope), tolerance ', tol
     nfail = nfail + 1
+  end if
+
+  ! 4. the finished run goes on to a later end of the run-out (0.05 -> 0.08 s)
+  ierr = mpmc_workflow_resume(ctx, trim(outdir), MPMC_WORKFLOW_QUIET, &
+                              [character(len=32) :: 'stages.runout.end.time=0.08'])
+  if (ierr /= MPMC_SUCCESS) then
+    write (*, '(a,i0,a,a)') 'FAILED: mpmc_workflow_resume with a later end returned ', ierr, ': ', &
+      mpmc_context_last_error(ctx)
+    nfail = nfail + 1
+  else
+    open (newunit=u, file=trim(outdir)//'/summary.json', status='old', action='read')
+    f_runout = -1
+    f_steps(3) = -1
+    do
+      call read_line(u, line, ios)
+      if (ios /= 0) exit
+      if (index(line, '{"name": "runout"') > 0) then
+        f_runout = number_after(line, '"sim_time":')
+        f_steps(3) = int(number_after(line, '"steps":'))
+      end if
+    end do
+    close (u)
+    if (.not. abs(f_runout - 0.08_c_double) < 1.0e-12_c_double .or. .not. f_steps(3) > wf_steps(3)) then
+      write (*, '(a,i0,a,es24.16,a,i0)') 'FAILED: resumed run-out: expected to end at 0.08 s with more than its ', &
+        wf_steps(3), ' steps, got ', f_runout, ' s, ', f_steps(3)
+      nfail = nfail + 1
+    end if
   end if
   if (mpmc_context_destroy(ctx) /= MPMC_SUCCESS) nfail = nfail + 1
   if (allocated(line)) deallocate (line)

@@ -180,6 +180,27 @@ static void test_check_and_resume(void **state) {
   const double uy2 = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
   if (fabs(uy2 - expect2) > 1e-9 * fabs(expect2))
     fail_msg("resume to a later end: tip_displacement_y expected %.12g, got %.12g", expect2, uy2);
+  /* a later end from the command line, after the run's own overrides: 20 steps more */
+  if (run_cli("resume '" DIR "/out-resume' --set stages.third.end.time=0.1 --quiet") != 0)
+    fail_msg("mpmc resume --set stages.third.end.time=0.1: expected exit 0");
+  const double steps3 = json_number(DIR "/out-resume/summary.json", "steps");
+  if (steps3 != 200) fail_msg("resume --set to a later end: expected 200 steps in all, got %g", steps3);
+  const double expect3 = -g * dt * dt * 200 * 201 / 2.0;
+  const double uy3 = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
+  if (fabs(uy3 - expect3) > 1e-9 * fabs(expect3))
+    fail_msg("resume --set to a later end: tip_displacement_y expected %.12g, got %.12g", expect3, uy3);
+  /* a bad override is named, and the outputs stay; --out does not apply to resume */
+  snprintf(before, sizeof before, "%s", slurp(DIR "/out-resume/summary.json"));
+  snprintf(cmd, sizeof cmd, "'%s' resume '" DIR "/out-resume' --set stages.third.end.tme=1 2>&1", MPMC_CLI);
+  pipe = popen(cmd, "r");
+  assert_non_null(pipe);
+  const size_t nb = fread(msg, 1, sizeof msg - 1, pipe);
+  msg[nb] = '\0';
+  if (pclose(pipe) == 0) fail_msg("resume with a misspelt override: expected a failure");
+  if (!strstr(msg, "tme")) fail_msg("resume with a misspelt override: the message does not name it: %s", msg);
+  if (strcmp(before, slurp(DIR "/out-resume/summary.json")) != 0) fail_msg("a refused resume rewrote summary.json");
+  if (run_cli("resume '" DIR "/out-resume' --out '" DIR "/elsewhere'") != 2) fail_msg("resume --out: expected exit 2");
+  snprintf(cmd, sizeof cmd, "'%s' resume '" DIR "/out-resume' 2>&1", MPMC_CLI);
   /* and once more with nothing changed: finished, after three stages */
   pipe = popen(cmd, "r");
   assert_non_null(pipe);

@@ -8,13 +8,15 @@
 static const char usage[] =
     "usage: mpmc run SCENE.yaml [--out DIR] [--set key.path=value ...] [--threads N] [--force] [--quiet]\n"
     "       mpmc check SCENE.yaml [--set key.path=value ...]\n"
-    "       mpmc resume DIR [--quiet]\n"
+    "       mpmc resume DIR [--set key.path=value ...] [--threads N] [--quiet]\n"
     "       mpmc --help | --version\n"
     "\n"
     "  run     run every stage of the scene; outputs go to DIR (default out/<scene>):\n"
     "          summary.json, series.csv, snapshots.h5/.xdmf, checkpoint.h5, PNG plots\n"
     "  check   validate the scene (and the --set overrides) and print what would run\n"
-    "  resume  continue a run from the last checkpoint in DIR\n"
+    "  resume  continue a run from the last checkpoint in DIR (--set: after the run's own\n"
+    "          overrides); a finished run goes on once its scene has another stage or a\n"
+    "          later end for its last one, e.g. --set stages.runout.end.time=8\n"
     "\n"
     "  --set key.path=value  override any scene value, e.g. --set grid.cell_size=0.5\n"
     "                        --set fbar=false --set stages.runout.end.time=2\n"
@@ -87,11 +89,16 @@ int main(int argc, char **argv) {
     fprintf(stderr, "mpmc %s: missing %s\n%s", cmd, strcmp(cmd, "resume") ? "SCENE.yaml" : "DIR", usage);
     return 2;
   }
+  if (!strcmp(cmd, "resume") && (out || (flags & MPMC_WORKFLOW_FORCE))) {
+    fprintf(stderr, "mpmc resume: %s does not apply: the run goes on in its own directory %s\n%s",
+            out ? "--out" : "--force", target, usage);
+    return 2;
+  }
   mpmc_context ctx;
   if (mpmc_context_create(&ctx)) return 1;
   int err;
   if (!strcmp(cmd, "resume"))
-    err = mpmc_workflow_resume(ctx, target, flags & MPMC_WORKFLOW_QUIET);
+    err = mpmc_workflow_resume_set(ctx, target, nset, sets, flags & MPMC_WORKFLOW_QUIET);
   else
     err = mpmc_workflow_run(ctx, target, out, nset, sets, flags | (!strcmp(cmd, "check") ? MPMC_WORKFLOW_CHECK : 0));
   if (err) print_error(ctx, err);

@@ -770,8 +770,22 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
  * @param flags MPMC_WORKFLOW_QUIET
  */
 int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
+  return mpmc_workflow_resume_set(ctx, outdir, 0, NULL, flags);
+}
+
+/**
+ * @brief mpmc_workflow_resume with noverride "key.path=value" overrides applied after the
+ *        run's own (`mpmc resume DIR --set ...`): e.g. a later end for the last stage of a
+ *        finished run.  Later checkpoints record them with the run's.
+ */
+int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride, const char *const *overrides,
+                             int flags) {
   if (!ctx) return MPMC_ERR_ARG;
   MPMC_CHECK(outdir && outdir[0], ctx, MPMC_ERR_ARG, "output directory outdir is NULL or empty");
+  MPMC_CHECK(noverride >= 0 && (noverride == 0 || overrides), ctx, MPMC_ERR_ARG,
+             "resume: noverride = %d with overrides %s", noverride, overrides ? "given" : "NULL");
+  for (int i = 0; i < noverride; ++i)
+    MPMC_CHECK(overrides[i], ctx, MPMC_ERR_ARG, "resume: override %d is NULL", i);
 #ifndef MPMC_WF_HAVE_CHECKPOINT
   (void)flags;
   return MPMC_ERROR(ctx, MPMC_ERR_UNSUPPORTED, "resume: this build has no checkpoints (checkpoint.c)");
@@ -821,6 +835,11 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
     }
   }
   mpmc_free(meta);
+  for (int i = 0; i < noverride && !bad; ++i) { /* the caller's, after the run's own */
+    char **s2 = realloc(sets, sizeof *sets * (size_t)(nset + 1));
+    bad = !s2 || !((sets = s2)[nset] = strdup(overrides[i]));
+    nset += !bad;
+  }
   int err = 0;
   wf_run w = {0};
   w.ctx = ctx;
