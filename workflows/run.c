@@ -875,11 +875,15 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
       ke_max = 0.0; /* used by quasi-static ends only */
       ke_below = -1.0;
     } else {
+      char how[WF_PATH + 160] = "";
+      if (strcmp(r->reason, "quasi_static"))
+        snprintf(how, sizeof how,
+                 " or raise the last stage's end time (e.g. `mpmc resume %s --set stages.%s.end.%s=T`, T > %.6g)",
+                 outdir, last->name, last->end_kind == WF_END_QUASI_STATIC ? "max_time" : "time", r->sim_time);
       err = fail(&w, MPMC_ERR_STATE,
                  "resume: the run in %s finished all %d stages of %s (checkpoint at t = %.6g s, stage '%s' "
-                 "ended by %s at %.6g s); to continue it, add a stage to the scene%s and resume again",
-                 outdir, stage, scene, t_ckpt, last->name, r->reason, r->sim_time,
-                 strcmp(r->reason, "quasi_static") ? " or raise the last stage's end time" : "");
+                 "ended by %s at %.6g s); to continue it, add a stage to the scene%s",
+                 outdir, stage, scene, t_ckpt, last->name, r->reason, r->sim_time, how);
     }
   }
   if (err) {
