@@ -330,6 +330,27 @@ static void test_ids(void **state) {
   mpmc_context_destroy(&ctx);
 }
 
+/* a's state through a checkpoint file (path, removed after) into a new sim */
+static mpmc_sim restarted(mpmc_context ctx, mpmc_sim a, const char *path) {
+  TCALL(mpmc_sim_checkpoint_write(a, path, NULL));
+  mpmc_sim b;
+  TCALL(mpmc_sim_checkpoint_read(ctx, path, &b, NULL));
+  unlink(path);
+  return b;
+}
+
+/* the restarted run b is the straight run a, bit for bit: ids, positions, velocities, stresses */
+static void expect_same_run(mpmc_sim a, mpmc_sim b) {
+  const int *ia, *ib;
+  TCALL(mpmc_sim_get_particle_ids(a, &ia));
+  TCALL(mpmc_sim_get_particle_ids(b, &ib));
+  const size_t n = (size_t)a->p.n, d = (size_t)a->dim;
+  if (b->p.n != a->p.n || memcmp(ia, ib, sizeof(int) * n)) fail_msg("ids differ after the restart");
+  if (memcmp(a->p.x, b->p.x, sizeof(double) * d * n) || memcmp(a->p.v, b->p.v, sizeof(double) * d * n) ||
+      memcmp(a->p.stress, b->p.stress, sizeof(double) * 6 * n))
+    fail_msg("the restarted run differs from the straight one");
+}
+
 /* a checkpoint in the middle of a sorting run restarts to the same bits */
 static void test_checkpoint(void **state) {
   (void)state;
@@ -342,10 +363,7 @@ static void test_checkpoint(void **state) {
   double dt;
   TCALL(mpmc_sim_stable_dt(a, 0.3, &dt));
   for (int s = 0; s < 10; ++s) TCALL(mpmc_sim_step(a, dt)); /* sorted at 0, 4, 8 */
-  TCALL(mpmc_sim_checkpoint_write(a, path, NULL));
-  mpmc_sim b;
-  TCALL(mpmc_sim_checkpoint_read(ctx, path, &b, NULL));
-  unlink(path);
+  mpmc_sim b = restarted(ctx, a, path);
   int every;
   TCALL(mpmc_sim_get_sort_interval(b, &every));
   if (every != 4) fail_msg("restored sort interval %d", every);
@@ -353,14 +371,7 @@ static void test_checkpoint(void **state) {
     TCALL(mpmc_sim_step(a, dt));
     TCALL(mpmc_sim_step(b, dt));
   }
-  const int *ia, *ib;
-  TCALL(mpmc_sim_get_particle_ids(a, &ia));
-  TCALL(mpmc_sim_get_particle_ids(b, &ib));
-  const int n = a->p.n;
-  if (memcmp(ia, ib, sizeof(int) * (size_t)n)) fail_msg("ids differ after the restart");
-  if (memcmp(a->p.x, b->p.x, sizeof(double) * 2 * (size_t)n) ||
-      memcmp(a->p.stress, b->p.stress, sizeof(double) * 6 * (size_t)n))
-    fail_msg("the restarted run differs from the straight one");
+  expect_same_run(a, b);
   mpmc_sim_destroy(&a);
   mpmc_sim_destroy(&b);
   mpmc_context_destroy(&ctx);
@@ -407,15 +418,11 @@ static void test_axis_change(void **state) {
   for (int q = 0; q < n; ++q) x[q * 3 + 2] = 0.2 + 0.1 * (x[q * 3 + 2] - 0.2); /* 3 planes */
   TCALL(mpmc_sim_restore_field(a, MPMC_FIELD_POSITION, &x));
   TCALL(mpmc_sim_step(a, dt)); /* its slab build picks y */
-  TCALL(mpmc_sim_checkpoint_write(a, path, NULL));
-  mpmc_sim b;
-  TCALL(mpmc_sim_checkpoint_read(ctx, path, &b, NULL));
-  unlink(path);
+  mpmc_sim b = restarted(ctx, a, path);
   for (int s = 0; s < 5; ++s) { /* step 5 (a tenth of 50) sorts */
     TCALL(mpmc_sim_step(a, dt));
     TCALL(mpmc_sim_step(b, dt));
   }
-  const int *ia, *ib;
   for (int k = 0; k < 2; ++k) {
     const mpmc_sim s = k ? b : a;
     for (int q = 1; q < n; ++q)
@@ -423,11 +430,7 @@ static void test_axis_change(void **state) {
         fail_msg("%s run, 5 steps after the slab axis became y: the points are not sorted by y cell (point %d)",
                  k ? "restarted" : "straight", q);
   }
-  TCALL(mpmc_sim_get_particle_ids(a, &ia));
-  TCALL(mpmc_sim_get_particle_ids(b, &ib));
-  if (memcmp(ia, ib, sizeof(int) * (size_t)n)) fail_msg("ids differ after the restart");
-  if (memcmp(a->p.x, b->p.x, sizeof(double) * 3 * (size_t)n) || memcmp(a->p.v, b->p.v, sizeof(double) * 3 * (size_t)n))
-    fail_msg("the restarted run differs from the straight one");
+  expect_same_run(a, b);
   mpmc_sim_destroy(&a);
   mpmc_sim_destroy(&b);
   mpmc_context_destroy(&ctx);

@@ -113,11 +113,24 @@ static void test_free_fall(void **state) {
   }
 }
 
-static int run_cli(const char *args) {
-  char cmd[2048];
-  snprintf(cmd, sizeof cmd, "'%s' %s >/dev/null 2>&1", MPMC_CLI, args);
-  const int st = system(cmd);
+/* `mpmc args`: its exit status, and the start of what it printed (stdout and stderr) in msg;
+ * the rest is read and dropped, so the program never waits on a full pipe */
+static int cli_output(const char *args, char *msg, size_t len) {
+  char cmd[2048], rest[4096];
+  snprintf(cmd, sizeof cmd, "'%s' %s 2>&1", MPMC_CLI, args);
+  FILE *pipe = popen(cmd, "r");
+  assert_non_null(pipe);
+  const size_t n = fread(msg, 1, len - 1, pipe);
+  msg[n] = '\0';
+  while (fread(rest, 1, sizeof rest, pipe) > 0) {
+  }
+  const int st = pclose(pipe);
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int run_cli(const char *args) {
+  char msg[4096];
+  return cli_output(args, msg, sizeof msg);
 }
 
 static void test_check_and_resume(void **state) {
@@ -140,13 +153,9 @@ static void test_check_and_resume(void **state) {
   if (strcmp(before, slurp(DIR "/out-resume/summary.json")) != 0)
     fail_msg("resume of a finished run rewrote summary.json");
   /* the message says what to do */
-  char cmd[1024], msg[2048] = "";
-  snprintf(cmd, sizeof cmd, "'%s' resume '" DIR "/out-resume' 2>&1", MPMC_CLI);
-  FILE *pipe = popen(cmd, "r");
-  assert_non_null(pipe);
-  const size_t nm = fread(msg, 1, sizeof msg - 1, pipe);
-  msg[nm] = '\0';
-  if (pclose(pipe) == 0) fail_msg("resume of a finished run: expected a failure");
+  char msg[2048];
+  if (cli_output("resume '" DIR "/out-resume'", msg, sizeof msg) == 0)
+    fail_msg("resume of a finished run: expected a failure");
   if (!strstr(msg, "finished all 2 stages") || !strstr(msg, "add a stage"))
     fail_msg("resume of a finished run: expected 'finished all 2 stages ... add a stage', got: %s", msg);
   /* one more stage in the scene: resuming runs it alone */
@@ -191,22 +200,13 @@ static void test_check_and_resume(void **state) {
     fail_msg("resume --set to a later end: tip_displacement_y expected %.12g, got %.12g", expect3, uy3);
   /* a bad override is named, and the outputs stay; --out does not apply to resume */
   snprintf(before, sizeof before, "%s", slurp(DIR "/out-resume/summary.json"));
-  snprintf(cmd, sizeof cmd, "'%s' resume '" DIR "/out-resume' --set stages.third.end.tme=1 2>&1", MPMC_CLI);
-  pipe = popen(cmd, "r");
-  assert_non_null(pipe);
-  const size_t nb = fread(msg, 1, sizeof msg - 1, pipe);
-  msg[nb] = '\0';
-  if (pclose(pipe) == 0) fail_msg("resume with a misspelt override: expected a failure");
+  if (cli_output("resume '" DIR "/out-resume' --set stages.third.end.tme=1", msg, sizeof msg) == 0)
+    fail_msg("resume with a misspelt override: expected a failure");
   if (!strstr(msg, "tme")) fail_msg("resume with a misspelt override: the message does not name it: %s", msg);
   if (strcmp(before, slurp(DIR "/out-resume/summary.json")) != 0) fail_msg("a refused resume rewrote summary.json");
   if (run_cli("resume '" DIR "/out-resume' --out '" DIR "/elsewhere'") != 2) fail_msg("resume --out: expected exit 2");
-  snprintf(cmd, sizeof cmd, "'%s' resume '" DIR "/out-resume' 2>&1", MPMC_CLI);
   /* and once more with nothing changed: finished, after three stages */
-  pipe = popen(cmd, "r");
-  assert_non_null(pipe);
-  const size_t nm2 = fread(msg, 1, sizeof msg - 1, pipe);
-  msg[nm2] = '\0';
-  if (pclose(pipe) == 0) fail_msg("resume of the finished run: expected a failure");
+  if (cli_output("resume '" DIR "/out-resume'", msg, sizeof msg) == 0) fail_msg("resume of the finished run: expected a failure");
   if (!strstr(msg, "finished all 3 stages") || !strstr(msg, "raise the last stage's end time"))
     fail_msg("resume of a finished run: expected 'finished all 3 stages ... raise the last stage's end time', got: %s", msg);
 }

@@ -657,10 +657,11 @@ static int run_all(wf_run *w, int first_stage, double t_stage, long steps, doubl
     /* at the start of the next stage; after the last one, the finished run (stage = nstage),
      * which `mpmc resume` continues once the scene has another stage: that one only warns
      * when it cannot be written, the run itself is done and its outputs follow */
-    if (i + 1 < w->sc.nstage && checkpoint(w, i + 1, 0, steps, 0, 0)) return -1;
-    if (i + 1 == w->sc.nstage && checkpoint(w, i + 1, 0, steps, 0, 0))
+    if (checkpoint(w, i + 1, 0, steps, 0, 0)) {
+      if (i + 1 < w->sc.nstage) return -1;
       say(w, "warning: the final checkpoint: %s (the run is complete; it cannot be extended by `mpmc resume`)",
           mpmc_context_last_error(w->ctx));
+    }
 #endif
   }
   return 0;
@@ -886,13 +887,12 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
                  outdir, stage, scene, t_ckpt, last->name, r->reason, r->sim_time, how);
     }
   }
-  if (err) {
-  } else if (nwall < walls_before || nwall > w.nwall_ids || ndone != stage || stage > w.sc.nstage) {
+  if (!err && (nwall < walls_before || nwall > w.nwall_ids || ndone != stage || stage > w.sc.nstage)) {
     err = fail(&w, MPMC_ERR_FORMAT,
                "resume: the scene %s no longer matches the checkpoint (stages or walls changed: %d stages "
                "done, %d walls recorded; the scene has %d stages, %d walls)",
                scene, ndone, nwall, w.sc.nstage, w.nwall_ids);
-  } else {
+  } else if (!err) {
     snprintf(w.out, sizeof w.out, "%s", outdir);
     if (nwall) memcpy(w.wall_ids, walls, sizeof *walls * (size_t)nwall);
     for (int i = 0; i < ndone; ++i) {

@@ -288,8 +288,8 @@ struct mpmc_sim_s {
   int64_t sort_last;            /* step count at the last sort; -1: none yet (sort.c)   */
   int sort_axis;                /* the slab axis the last sort put outermost; -1: none  */
   /* max_p |v_p|^2 as G2P left v (stability.c reads it instead of a pass over v): valid
-   * until anything else may write v, i.e. while the velocity field is not borrowed
-   * (mpmc_sim_get_field, until mpmc_sim_restore_field) */
+   * (v2max_ok) from a G2P while the velocity field is not borrowed (mpmc_sim_get_field,
+   * until mpmc_sim_restore_field: both clear it) */
   double v2max;
   int v2max_ok, v_borrowed;
   /* the position array as a caller borrowed it (mpmc_sim_get_field, until its restore):

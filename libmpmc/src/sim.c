@@ -408,7 +408,7 @@ int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   MPMC_CHECK(f, sim->ctx, MPMC_ERR_ARG, "field = %d is not a particle field", field);
   if (!*f && sim->grid.valid) MPMC_CALL(mpmc_sim_prepare(sim));
   MPMC_CHECK(*f, sim->ctx, MPMC_ERR_STATE, "this simulation has no '%s' field", field_names[field]);
-  if (field == MPMC_FIELD_VELOCITY) sim->v_borrowed = 1; /* G2P's max |v| no longer holds */
+  if (field == MPMC_FIELD_VELOCITY) sim->v_borrowed = 1, sim->v2max_ok = 0; /* G2P's max |v| no longer holds */
   if (field == MPMC_FIELD_POSITION) sim->x_lent = *f;    /* kept in place by the step    */
   *data = *f;
   if (ncomp) *ncomp = nc;

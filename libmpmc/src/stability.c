@@ -17,7 +17,7 @@ double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
     }
   }
   double vmax = 0.0;
-  if (sim->v2max_ok && !sim->v_borrowed) {
+  if (sim->v2max_ok) {
     vmax = sim->v2max; /* G2P's, the same sums (g2p.c) */
   } else {
 #pragma omp parallel for reduction(max : vmax) schedule(static) if (p->n > MPMC_OMP_MIN)
