@@ -48,15 +48,15 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   mpmc_point_weights(DIM, BASIS, 0, g, p->x + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
   const mpmc_v2d vv = scatter_values(sim, DIM, q);
-  /* in the products' order of P2G (V: w_x (wyz V)) and G2P (V j: ((w_x V j) w_z) w_y) */
+  /* in the products' order of P2G (V: w_x (w_y (w_z V))) and G2P (V j: ((w_x V j) w_z) w_y) */
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
   for (int k = 0; k < (DIM == 3 ? S : 1); ++k)
     for (int j = 0; j < S; ++j) {
       const size_t row = pw.node0 + sy * (size_t)j + sz * (size_t)k;
-      const double wz = DIM == 3 ? pw.w[k][2] : 1.0, wyz = pw.w[j][1] * wz;
+      const double wz = DIM == 3 ? pw.w[k][2] : 1.0, wyzv = pw.w[j][1] * (wz * vv[0]);
       for (int i = 0; i < S; ++i) {
         const double wxj = pw.w[i][0] * vv[1];
-        rec[(row + i) * MPMC_NREC + MPMC_VSLOT] += pw.w[i][0] * (wyz * vv[0]);
+        rec[(row + i) * MPMC_NREC + MPMC_VSLOT] += pw.w[i][0] * wyzv;
         fj[row + i] += (DIM == 3 ? wxj * wz : wxj) * pw.w[j][1];
       }
     }

@@ -64,9 +64,8 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
   }
 }
 
-/* Gather point q; returns 0 if its volume inverted or it left the grid.  Per row of the
- * stencil the sums over the row's node records, sw = sum w_x rec and sd = sum w_x' rec, give
- *   (v_pic, dv) += wyz sw,  L_a. += (wyz sd_va, dyz sw_va, ydz sw_va),
+/* Gather point q; returns 0 if its volume inverted or it left the grid.  The sums over the
+ * stencil's node records are factored by axis (rows along x, then planes, then z; below),
  * all whole-vector multiply-adds in record layout; the components are picked out once.
  * FB = 1 (3: in rows of four, fb_scatter): also scatter V^n j of Algorithm 1 step 3 into fb
  * (the grid's fbj, one value per node) with the same weights (the points are still at x^n;
@@ -91,24 +90,49 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   mpmc_vd A[MPMC_NV], B0[MPMC_NC], B1[MPMC_NC], B2[MPMC_NC];
   for (int k = 0; k < NV; ++k) A[k] = zero;
   for (int k = 0; k < NC; ++k) B0[k] = B1[k] = B2[k] = zero;
-  MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
-    mpmc_vd sw[MPMC_NV], sd[MPMC_NC];
-    for (int k = 0; k < N1; ++k) sw[k] = zero;
-    for (int k = 0; k < NC; ++k) sd[k] = zero;
-    const double *restrict r = rec + row * R;
-    for (int i = 0; i < S; ++i) {
-      const double wx = pw.w[i][0], dx = pw.dw[i][0];
-      const double *ri = r + i * R;
-      for (int k = 0; k < N1; ++k) sw[k] += wx * MPMC_VC(ri + MPMC_VW * k);
-      for (int k = 0; k < NC; ++k) sd[k] += dx * MPMC_VC(ri + MPMC_VW * k);
+  /* Sums factored by axis: per row along x sw = sum_i w_x rec, sd = sum_i w_x' rec; per
+   * plane of rows (one in 2D) P = sum_j w_y sw, Pd = sum_j w_y sd, Py = sum_j w_y' sw; then
+   *   (v_pic, dv) += w_z P,  L_a. += (w_z Pd_va, w_z Py_va, w_z' P_va).
+   * In 2D w_z = 1 and the sums are those of a row-by-row loop, bit for bit. */
+  const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
+  for (int kz = 0; kz < (DIM == 3 ? S : 1); ++kz) {
+    mpmc_vd P[MPMC_NV], Pd[MPMC_NC], Py[MPMC_NC];
+    for (int k = 0; k < N1; ++k) P[k] = zero;
+    for (int k = 0; k < NC; ++k) Pd[k] = Py[k] = zero;
+    for (int j = 0; j < S; ++j) {
+      mpmc_vd sw[MPMC_NV], sd[MPMC_NC];
+      for (int k = 0; k < N1; ++k) sw[k] = zero;
+      for (int k = 0; k < NC; ++k) sd[k] = zero;
+      const double *restrict r = rec + (pw.node0 + sy * (size_t)j + sz * (size_t)kz) * R;
+      for (int i = 0; i < S; ++i) {
+        const double wx = pw.w[i][0], dx = pw.dw[i][0];
+        const double *ri = r + i * R;
+        for (int k = 0; k < N1; ++k) sw[k] += wx * MPMC_VC(ri + MPMC_VW * k);
+        for (int k = 0; k < NC; ++k) sd[k] += dx * MPMC_VC(ri + MPMC_VW * k);
+      }
+      const double wy = pw.w[j][1], dy = pw.dw[j][1];
+      for (int k = 0; k < N1; ++k) P[k] += wy * sw[k];
+      for (int k = 0; k < NC; ++k) {
+        Pd[k] += wy * sd[k];
+        Py[k] += dy * sw[k];
+      }
     }
-    for (int k = 0; k < N1; ++k) A[k] += wyz * sw[k];
-    for (int k = 0; k < NC; ++k) {
-      B0[k] += wyz * sd[k];
-      B1[k] += dyz * sw[k];
-      if (DIM == 3) B2[k] += ydz * sw[k];
+    if (DIM == 3) {
+      const double wz = pw.w[kz][2], dz = pw.dw[kz][2];
+      for (int k = 0; k < N1; ++k) A[k] += wz * P[k];
+      for (int k = 0; k < NC; ++k) {
+        B0[k] += wz * Pd[k];
+        B1[k] += wz * Py[k];
+        B2[k] += dz * P[k];
+      }
+    } else {
+      for (int k = 0; k < N1; ++k) A[k] += P[k];
+      for (int k = 0; k < NC; ++k) {
+        B0[k] += Pd[k];
+        B1[k] += Py[k];
+      }
     }
-  });
+  }
   /* B_b = (., L_.b) in record slots */
   double L[3][3];
   for (int i = 0; i < DIM; ++i) {
@@ -138,18 +162,22 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
   }
   if (FB == 1 || FB == 3) fb_scatter(DIM, BASIS, FB == 3, g, fb, &pw, vj);
-  if (SPLIT) {
-    MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
-      mpmc_vd sw[MPMC_NV];
-      for (int k = N1; k < NV; ++k) sw[k] = zero;
-      const double *restrict r = rec + row * R;
-      for (int i = 0; i < S; ++i) {
-        const double wx = pw.w[i][0];
-        for (int k = N1; k < NV; ++k) sw[k] += wx * MPMC_VC(r + i * R + MPMC_VW * k);
+  if (SPLIT) /* the increment half, factored as above */
+    for (int kz = 0; kz < (DIM == 3 ? S : 1); ++kz) {
+      mpmc_vd P[MPMC_NV];
+      for (int k = N1; k < NV; ++k) P[k] = zero;
+      for (int j = 0; j < S; ++j) {
+        mpmc_vd sw[MPMC_NV];
+        for (int k = N1; k < NV; ++k) sw[k] = zero;
+        const double *restrict r = rec + (pw.node0 + sy * (size_t)j + sz * (size_t)kz) * R;
+        for (int i = 0; i < S; ++i) {
+          const double wx = pw.w[i][0];
+          for (int k = N1; k < NV; ++k) sw[k] += wx * MPMC_VC(r + i * R + MPMC_VW * k);
+        }
+        for (int k = N1; k < NV; ++k) P[k] += pw.w[j][1] * sw[k];
       }
-      for (int k = N1; k < NV; ++k) A[k] += wyz * sw[k];
-    });
-  }
+      for (int k = N1; k < NV; ++k) A[k] += (DIM == 3 ? pw.w[kz][2] : 1.0) * P[k];
+    }
   /* A = (., v_pic | dv) */
   double vpic[3], dv[3];
   for (int i = 0; i < DIM; ++i) {
@@ -172,21 +200,34 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   return ok;
 }
 
-/* g2p_point with F-bar's scatter into fbuf, in form fb (1: Algorithm 1's weights, V^n j into
- * the grid's fbj or a copy of it, in rows of four nodes with wide (fb_scatter); 2: the stable
- * form's, into fb or a copy) */
-MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS, int fb, int wide,
-                                   double dt, const g2p_ctx *c, double *restrict fbuf, int q,
-                                   double *v2max) {
-  return fb == 2 ? g2p_point(sim, DIM, BASIS, 2, dt, c, fbuf, q, v2max)
-         : wide  ? g2p_point(sim, DIM, BASIS, 3, dt, c, fbuf, q, v2max)
-                 : g2p_point(sim, DIM, BASIS, 1, dt, c, fbuf, q, v2max);
-}
-
 /* Without F-bar the points run in index order, split evenly among the threads; with it by
  * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
  * fused scatter is race-free, or, when P2G scattered into one grid per thread, in P2G's
- * chunks, each thread scattering into its own copy of fb. */
+ * chunks, each thread scattering into its own copy of fb.  The scatter's form FB (g2p_point)
+ * is chosen outside the loops: one form per loop body keeps the gather's sums in registers
+ * (with the three forms inlined into one loop GCC spilled some, 20 instructions a point). */
+#define G2P_CHUNKS(D, B, FBV)                                                                 \
+  do {                                                                                        \
+    const size_t per = sim->grid.nn * (size_t)((FBV) == 2 ? 2 : 1);                           \
+    _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) reduction(max : v2m) num_threads(nc)") \
+    for (int t = 0; t < nc; ++t) {                                                            \
+      double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                     \
+      const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                                  \
+      for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1_; ++k)                           \
+        if (!g2p_point(sim, D, B, FBV, dt, c, f_, order[k], &v2m) && order[k] < first_bad)    \
+          first_bad = order[k];                                                               \
+    }                                                                                         \
+  } while (0)
+#define G2P_SLABS(D, B, FBV)                                                                  \
+  do {                                                                                        \
+    for (int colour = 0; colour < 2; ++colour) {                                              \
+      _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
+      for (int sl = colour; sl < sim->nslab; sl += 2)                                         \
+        for (int k = start[sl]; k < start[sl + 1]; ++k)                                       \
+          if (!g2p_point(sim, D, B, FBV, dt, c, fb0, order[k], &v2m) && order[k] < first_bad) \
+            first_bad = order[k];                                                             \
+    }                                                                                         \
+  } while (0)
 #define G2P_KERNEL(D, B)                                                                      \
   static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad, double *vm) { \
     int first_bad = INT_MAX;                                                                  \
@@ -200,31 +241,21 @@ MPMC_ALWAYS_INLINE int g2pfb_point(mpmc_sim sim, const int DIM, const int BASIS,
   static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, double *fbp, int nc, \
                               int *bad, double *vm) {                                         \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;                \
-    const int fb = sim->fbar == MPMC_FBAR_STABLE ? 2 : 1;                                     \
-    double *fb0 = fb == 2 ? sim->grid.fb : sim->grid.fbj;                                     \
+    const int stable = sim->fbar == MPMC_FBAR_STABLE;                                         \
+    double *fb0 = stable ? sim->grid.fb : sim->grid.fbj;                                      \
     int first_bad = INT_MAX;                                                                  \
     double v2m = 0.0;                                                                         \
     if (fbp) { /* P2G's chunks, each scattering into its own copy (p2g.c) */                  \
-      const size_t per = sim->grid.nn * (size_t)fb;                                           \
-      _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) reduction(max : v2m) num_threads(nc)") \
-      for (int t = 0; t < nc; ++t) {                                                          \
-        double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                   \
-        const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                                \
-        for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1_; ++k)                         \
-          if (!g2pfb_point(sim, D, B, fb, 0, dt, c, f_, order[k], &v2m) && order[k] < first_bad) \
-            first_bad = order[k];                                                             \
-      }                                                                                       \
-      *bad = first_bad == INT_MAX ? -1 : first_bad;                                           \
-      *vm = v2m;                                                                                \
-      return;                                                                                 \
-    }                                                                                         \
-    const int wide = sim->slab_axis != 0; /* rows along x lie within a slab */                \
-    for (int colour = 0; colour < 2; ++colour) {                                              \
-      _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
-      for (int sl = colour; sl < sim->nslab; sl += 2)                                         \
-        for (int k = start[sl]; k < start[sl + 1]; ++k)                                       \
-          if (!g2pfb_point(sim, D, B, fb, wide, dt, c, fb0, order[k], &v2m) && order[k] < first_bad) \
-            first_bad = order[k];                                                             \
+      if (stable)                                                                             \
+        G2P_CHUNKS(D, B, 2);                                                                  \
+      else                                                                                    \
+        G2P_CHUNKS(D, B, 1);                                                                  \
+    } else if (stable) {                                                                      \
+      G2P_SLABS(D, B, 2);                                                                     \
+    } else if (sim->slab_axis != 0) { /* rows along x lie within a slab: fb_scatter's WIDE */ \
+      G2P_SLABS(D, B, 3);                                                                     \
+    } else {                                                                                  \
+      G2P_SLABS(D, B, 1);                                                                     \
     }                                                                                         \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                             \
     *vm = v2m;                                                                                \

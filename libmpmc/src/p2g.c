@@ -183,13 +183,15 @@ MPMC_ALWAYS_INLINE double rec_slot(const int DIM, int s, double m, const double 
 
 /* Scatter point q: mass, momentum and force w m, w m v, -V sigma grad w + w f_ext, all
  * into the node records, and with F-bar's paper and total forms the volume w V^n into
- * MPMC_VSLOT (Algorithm 1 step 3's nodal volume: the same products w_x (wyz V) as G2P's scatter
- * of V^n j, the other terms adding exact zeros to the slot).
+ * MPMC_VSLOT (Algorithm 1 step 3's nodal volume, as the products w_x (w_y (w_z V)) that
+ * fbar.c's scatter_point repeats; the other terms add exact zeros to the slot).
  * Per row of the stencil the record's increment splits as
- *   rec += w_x c + w_x' e,  c = wyz (m, m v, f_ext, V) + dyz (-V sigma_.1) + ydz (-V sigma_.2),
- *                           e = wyz (-V sigma_.0)
- * (grad w = (w_x' wyz, w_x dyz, w_x ydz)), with c and e fixed along the row: per node a few
- * whole-vector multiply-adds on one record. */
+ *   rec += w_x c + w_x' e,  c = w_y (w_z (m, m v, f_ext, V) + w_z' (-V sigma_.2))
+ *                               + w_y' w_z (-V sigma_.1),
+ *                           e = w_y w_z (-V sigma_.0)
+ * (grad w = (w_x' w_y w_z, w_x w_y' w_z, w_x w_y w_z')), the w_z factors formed once per
+ * plane of rows, c and e once per row: per node a few whole-vector multiply-adds on one
+ * record. */
 MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
                                    double *restrict rec, int q) {
   mpmc_grid *g = &sim->grid;
@@ -235,22 +237,39 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
 #undef S0_
 #undef S1_
 #undef S2_
-  MPMC_ROW_LOOP(DIM, BASIS, g, pw, {
-    mpmc_vd c[MPMC_NV], e[MPMC_NV];
-    for (int k = 0; k < NC; ++k) c[k] = wyz * MF[k];
-    for (int k = NC; k < NV; ++k) {
-      c[k] = wyz * MF[k] + dyz * S1[k];
-      if (DIM == 3) c[k] += ydz * S2[k];
-      e[k] = wyz * S0[k];
+  const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
+  for (int kz = 0; kz < (DIM == 3 ? S : 1); ++kz) {
+    /* the plane's factors: MF w_z + S2 w_z' (the latter in the force half), S1 w_z, S0 w_z
+     * (in 2D the factors themselves, and the rows' sums those of the row-by-row form) */
+    mpmc_vd MFz[MPMC_NV], S1z[MPMC_NV], S0z[MPMC_NV];
+    if (DIM == 3) {
+      const double wz = pw.w[kz][2], dz = pw.dw[kz][2];
+      for (int k = 0; k < NC; ++k) MFz[k] = wz * MF[k];
+      for (int k = NC; k < NV; ++k) {
+        MFz[k] = wz * MF[k] + dz * S2[k];
+        S1z[k] = wz * S1[k];
+        S0z[k] = wz * S0[k];
+      }
+    } else {
+      for (int k = 0; k < NV; ++k) MFz[k] = MF[k], S1z[k] = S1[k], S0z[k] = S0[k];
     }
-    double *restrict r = rec + row * R;
-    for (int i = 0; i < S; ++i) {
-      const double wx = pw.w[i][0], dx = pw.dw[i][0];
-      double *ri = r + i * R;
-      for (int k = 0; k < NC; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k];
-      for (int k = NC; k < NV; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k] + dx * e[k];
+    for (int j = 0; j < S; ++j) {
+      const double wy = pw.w[j][1], dy = pw.dw[j][1];
+      mpmc_vd c[MPMC_NV], e[MPMC_NV];
+      for (int k = 0; k < NC; ++k) c[k] = wy * MFz[k];
+      for (int k = NC; k < NV; ++k) {
+        c[k] = wy * MFz[k] + dy * S1z[k];
+        e[k] = wy * S0z[k];
+      }
+      double *restrict r = rec + (pw.node0 + sy * (size_t)j + sz * (size_t)kz) * R;
+      for (int i = 0; i < S; ++i) {
+        const double wx = pw.w[i][0], dx = pw.dw[i][0];
+        double *ri = r + i * R;
+        for (int k = 0; k < NC; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k];
+        for (int k = NC; k < NV; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k] + dx * e[k];
+      }
     }
-  });
+  }
 }
 
 /* Slabs of two colours keep nt threads busy when each colour splits evenly among them.  A

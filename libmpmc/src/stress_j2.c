@@ -214,22 +214,35 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         const int q0 = 4 * blk;
         int act[4], nact = 0;
         v4 F[9], b[6];
-        for (int l = 0; l < 4; ++l) {
-          const int q = q0 + l;
-          act[l] = q < n && p->mat[q] == id;
-          nact += act[l];
-          if (act[l]) {
-            const double *f = p->dF + (size_t)q * d * d, *be = p->be + (size_t)q * 6;
-            const double sc = gather ? scale[q - c0] : 1.0; /* dF-bar = sc dF */
-            for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j)
-                F[3 * i + j][l] = (i < d && j < d) ? f[i * d + j] * sc : (i == j);
-            for (int k = 0; k < 6; ++k) b[k][l] = be[k];
-          } else { /* identity: a finite, elastic dummy */
-            for (int k = 0; k < 9; ++k) F[k][l] = (k % 4 == 0);
-            for (int k = 0; k < 6; ++k) b[k][l] = k < 3;
+        if (d == 3 && q0 + 3 < n && p->mat[q0] == id && p->mat[q0 + 1] == id &&
+            p->mat[q0 + 2] == id && p->mat[q0 + 3] == id) {
+          /* four points of this material: whole vectors (lane by lane through memory, the
+           * vectors' loads would wait on four scalar stores each) */
+          const double *f = p->dF + (size_t)q0 * 9, *be = p->be + (size_t)q0 * 6;
+          const v4 sc = gather ? (v4){scale[q0 - c0], scale[q0 - c0 + 1], scale[q0 - c0 + 2],
+                                      scale[q0 - c0 + 3]}
+                               : (v4){1.0, 1.0, 1.0, 1.0};
+          for (int k = 0; k < 9; ++k) F[k] = (v4){f[k], f[9 + k], f[18 + k], f[27 + k]} * sc;
+          for (int k = 0; k < 6; ++k) b[k] = (v4){be[k], be[6 + k], be[12 + k], be[18 + k]};
+          for (int l = 0; l < 4; ++l) act[l] = 1;
+          nact = 4;
+        } else
+          for (int l = 0; l < 4; ++l) {
+            const int q = q0 + l;
+            act[l] = q < n && p->mat[q] == id;
+            nact += act[l];
+            if (act[l]) {
+              const double *f = p->dF + (size_t)q * d * d, *be = p->be + (size_t)q * 6;
+              const double sc = gather ? scale[q - c0] : 1.0; /* dF-bar = sc dF */
+              for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                  F[3 * i + j][l] = (i < d && j < d) ? f[i * d + j] * sc : (i == j);
+              for (int k = 0; k < 6; ++k) b[k][l] = be[k];
+            } else { /* identity: a finite, elastic dummy */
+              for (int k = 0; k < 9; ++k) F[k][l] = (k % 4 == 0);
+              for (int k = 0; k < 6; ++k) b[k][l] = k < 3;
+            }
           }
-        }
         if (!nact) continue;
         /* trial b = F b_e F^T (mpmc_push_forward's order): T = F B, then T F^T's upper half */
         const v4 B[3][3] = {{b[0], b[5], b[4]}, {b[5], b[1], b[3]}, {b[4], b[3], b[2]}};

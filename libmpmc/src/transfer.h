@@ -147,29 +147,6 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights(const int DIM, const int BASIS, cons
       }                                                                                    \
   } while (0)
 
-/* Loop over the stencil's rows along x (nodes node0 + i, i < S, contiguous in memory): the
- * body sees `row` (linear index of the row's first node) and the row's factors of the
- * tensor-product weight, `wyz` = w_y w_z, `dyz` = w_y' w_z and `ydz` = w_y w_z' (0 in 2D), so
- * that w = w_x wyz and grad w = (w_x' wyz, w_x dyz, w_x ydz).  The body runs the loop over
- * the row itself: with these products hoisted each node costs a few multiply-adds on one
- * contiguous record, which GCC vectorises across the record's components. */
-#define MPMC_ROW_LOOP(DIM, BASIS, g, pw, ...)                                            \
-  do {                                                                                   \
-    const int S_ = mpmc_stencil(BASIS);                                                  \
-    const size_t sy_ = (size_t)(g)->n[0], sz_ = (size_t)(g)->n[0] * (size_t)(g)->n[1];   \
-    for (int k_ = 0; k_ < (DIM == 3 ? S_ : 1); ++k_) {                                   \
-      const double wz_ = DIM == 3 ? (pw).w[k_][2] : 1.0;                                 \
-      const double dz_ = DIM == 3 ? (pw).dw[k_][2] : 0.0;                                \
-      for (int j_ = 0; j_ < S_; ++j_) {                                                  \
-        const size_t row = (pw).node0 + sy_ * (size_t)j_ + sz_ * (size_t)k_;             \
-        const double wyz = (pw).w[j_][1] * wz_, dyz = (pw).dw[j_][1] * wz_;              \
-        const double ydz = (pw).w[j_][1] * dz_;                                          \
-        (void)wyz, (void)dyz, (void)ydz;                                                 \
-        __VA_ARGS__                                                                      \
-      }                                                                                  \
-    }                                                                                    \
-  } while (0)
-
 /* The eight (dim, basis) instances.  A kernel's loop, with its OpenMP pragma, is written in a
  * macro X(D, B) expanded by MPMC_KERNELS with literal constants: GCC outlines OpenMP regions
  * before inlining, so constants passed into a function holding the pragma would reach the
