@@ -200,7 +200,9 @@ static int build(wf_run *w) {
 }
 
 static const char *kernels_name(int k) {
-  return k == MPMC_KERNELS_AVX2 ? "avx2 (x86-64-v3)" : "baseline";
+  return k == MPMC_KERNELS_FMA    ? "fma (x86-64-v3, fused multiply-adds)"
+         : k == MPMC_KERNELS_AVX2 ? "avx2 (x86-64-v3)"
+                                  : "baseline";
 }
 
 static void log_plan(const wf_run *w) {
@@ -591,7 +593,8 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
                                            : "false", w->sc.h);
   int kern = MPMC_KERNELS_BASELINE;
   mpmc_sim_get_kernels(w->sim, &kern);
-  fprintf(f, "  \"kernels\": \"%s\",\n", kern == MPMC_KERNELS_AVX2 ? "avx2" : "baseline");
+  fprintf(f, "  \"kernels\": \"%s\",\n",
+          kern == MPMC_KERNELS_FMA ? "fma" : kern == MPMC_KERNELS_AVX2 ? "avx2" : "baseline");
   int sort_every = 0;
   mpmc_sim_get_sort_interval(w->sim, &sort_every);
   fprintf(f, "  \"sort_interval\": %d,\n", sort_every);

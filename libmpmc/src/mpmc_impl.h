@@ -322,12 +322,15 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
   return ax;
 }
 
-/* The step's kernel phases (p2g.c, grid_update.c, g2p.c, fbar.c) exist once per instruction
- * set: CMakeLists.txt compiles these four files a second time for x86-64-v3 (AVX2) with
- * MPMC_ISA_AVX2 defined, which appends _avx2 to their external names.  A sim runs one set
- * (sim->kernels, mpmc_sim_set_kernels); the results are the same bits, as no floating-point
- * contraction is allowed in ISO C mode (tests/t303). */
-#ifdef MPMC_ISA_AVX2
+/* The step's kernel phases (p2g.c, grid_update.c, g2p.c, fbar.c, stress_j2.c) exist once per
+ * instruction set: CMakeLists.txt compiles these files twice more for x86-64-v3 (AVX2), with
+ * MPMC_ISA_AVX2 defined, which appends _avx2 to their external names, and with MPMC_ISA_FMA
+ * (_fma) and fused multiply-adds allowed.  A sim runs one set (sim->kernels,
+ * mpmc_sim_set_kernels); baseline and avx2 give the same bits, as ISO C mode allows no
+ * floating-point contraction (tests/t303); fma differs from them by round-off. */
+#if defined(MPMC_ISA_FMA)
+#define MPMC_ISA(fn) fn##_fma
+#elif defined(MPMC_ISA_AVX2)
 #define MPMC_ISA(fn) fn##_avx2
 #else
 #define MPMC_ISA(fn) fn
@@ -341,15 +344,17 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
   void mpmc_fbar_gather_range##S(struct mpmc_sim_s *sim, int id, int q0, int q1, double *scale);
 /* phases of one step (step.c calls them in this order, mpmc_stress_update last) */
 MPMC_KERNEL_PROTOTYPES()
-#if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2)
+#if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2) || defined(MPMC_ISA_FMA)
 MPMC_KERNEL_PROTOTYPES(_avx2)
+MPMC_KERNEL_PROTOTYPES(_fma)
 #endif
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
 /* the step's stress guard (stress_update.c): 0 if a component of s (Voigt) is NaN or Inf */
 static inline int mpmc_stress_finite(const double *s) {
   return isfinite(s[0] + s[1] + s[2] + s[3] + s[4] + s[5]);
 }
-/* 1 if this build carries the AVX2 kernels and the processor (and OS) runs them (sim.c) */
+/* 1 if this build carries the AVX2 kernels (avx2 and fma) and the processor (and OS) runs
+ * them (sim.c) */
 int mpmc_kernels_avx2_available(void);
 
 /* sort.c: before a step, sort the points by cell if the sort interval has passed */

@@ -119,8 +119,9 @@ int mpmc_rm_sim_workspaces(struct mpmc_sim_s *sim, int nthreads, mpmc_rm_ws ***w
   int mpmc_j2_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,               \
                        mpmc_rm_ws **ws, int64_t *nret, int64_t *nfb, int *first_bad);
 MPMC_J2_BATCH_PROTOTYPE()
-#if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2)
+#if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2) || defined(MPMC_ISA_FMA)
 MPMC_J2_BATCH_PROTOTYPE(_avx2)
+MPMC_J2_BATCH_PROTOTYPE(_fma)
 #endif
 
 #endif

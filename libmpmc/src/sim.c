@@ -32,31 +32,34 @@ static const char *avx2_missing(void) {
 #endif
 }
 
-/* Take a valid request (mpmc_kernels): AVX2 is refused where it cannot run, the message
- * naming the request as `what` says; AUTO becomes AVX2 where available, else BASELINE. */
+/* Take a valid request (mpmc_kernels): AVX2 and FMA are refused where they cannot run, the
+ * message naming the request as `what` says; AUTO becomes FMA where AVX2 is available, else
+ * BASELINE. */
 static int use_kernels(mpmc_sim s, int request, const char *what) {
   const int avx2 = mpmc_kernels_avx2_available();
-  MPMC_CHECK(request != MPMC_KERNELS_AVX2 || avx2, s->ctx, MPMC_ERR_ARG, "%s: %s", what,
-             avx2_missing());
-  s->kernels = request != MPMC_KERNELS_BASELINE && avx2 ? MPMC_KERNELS_AVX2 : MPMC_KERNELS_BASELINE;
+  MPMC_CHECK(request == MPMC_KERNELS_AUTO || request == MPMC_KERNELS_BASELINE || avx2, s->ctx,
+             MPMC_ERR_ARG, "%s: %s", what, avx2_missing());
+  s->kernels = request == MPMC_KERNELS_AUTO ? (avx2 ? MPMC_KERNELS_FMA : MPMC_KERNELS_BASELINE)
+                                            : request;
   return MPMC_SUCCESS;
 }
 
-/* The default set, or the one MPMC_KERNELS names (auto, baseline, avx2). */
+/* The default set, or the one MPMC_KERNELS names (auto, baseline, avx2, fma). */
 static int kernels_from_env(mpmc_sim s) {
+  static const char *const names[] = {"auto", "baseline", "avx2", "fma"};
   const char *e = getenv("MPMC_KERNELS");
   int req = MPMC_KERNELS_AUTO;
   if (e && *e) {
-    if (!strcmp(e, "baseline"))
-      req = MPMC_KERNELS_BASELINE;
-    else if (!strcmp(e, "avx2"))
-      req = MPMC_KERNELS_AVX2;
-    else
-      MPMC_CHECK(!strcmp(e, "auto"), s->ctx, MPMC_ERR_ARG,
-                 "environment variable MPMC_KERNELS = '%.40s' is not one of auto, baseline, avx2",
-                 e);
+    req = -1;
+    for (int k = 0; k < 4; ++k)
+      if (!strcmp(e, names[k])) req = k;
+    MPMC_CHECK(req >= 0, s->ctx, MPMC_ERR_ARG,
+               "environment variable MPMC_KERNELS = '%.40s' is not one of auto, baseline, avx2, "
+               "fma", e);
   }
-  return use_kernels(s, req, "environment variable MPMC_KERNELS = avx2");
+  char what[64];
+  snprintf(what, sizeof what, "environment variable MPMC_KERNELS = %s", names[req]);
+  return use_kernels(s, req, what);
 }
 
 /**
@@ -224,20 +227,22 @@ int mpmc_sim_set_threads(mpmc_sim sim, int nthreads) {
 }
 
 /**
- * @brief Instruction set of the step's transfer kernels (mpmc_kernels).  The sets give the
- * same results to the bit; AUTO (the default) takes AVX2 where the processor has it.
- * @param kernels MPMC_KERNELS_AUTO, _BASELINE, or _AVX2 (MPMC_ERR_ARG where this build or
- *        processor has no AVX2 kernels)
+ * @brief Instruction set of the step's transfer kernels (mpmc_kernels).  BASELINE and AVX2
+ * give the same results to the bit, FMA (fused multiply-adds, the fastest) differs from them
+ * by round-off; AUTO (the default) takes FMA where the processor has AVX2.
+ * @param kernels MPMC_KERNELS_AUTO, _BASELINE, _AVX2 or _FMA (MPMC_ERR_ARG for AVX2 and FMA
+ *        where this build or processor has no AVX2 kernels)
  */
 int mpmc_sim_set_kernels(mpmc_sim sim, int kernels) {
   if (!sim) return MPMC_ERR_ARG;
-  MPMC_CHECK(kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_AVX2, sim->ctx,
-             MPMC_ERR_ARG, "kernels = %d is not one of auto (0), baseline (1), avx2 (2)",
+  MPMC_CHECK(kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_FMA, sim->ctx,
+             MPMC_ERR_ARG, "kernels = %d is not one of auto (0), baseline (1), avx2 (2), fma (3)",
              kernels);
-  return use_kernels(sim, kernels, "kernels = avx2 (2)");
+  return use_kernels(sim, kernels, kernels == MPMC_KERNELS_FMA ? "kernels = fma (3)"
+                                                               : "kernels = avx2 (2)");
 }
 
-/** @brief The kernel set the step runs: MPMC_KERNELS_BASELINE or MPMC_KERNELS_AVX2. */
+/** @brief The kernel set the step runs: MPMC_KERNELS_BASELINE, _AVX2 or _FMA. */
 int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(kernels, sim->ctx, MPMC_ERR_ARG, "kernels pointer is NULL");

@@ -27,7 +27,12 @@ static const kernel_set baseline = {mpmc_slabs_build, mpmc_p2g, mpmc_grid_update
 #ifdef MPMC_HAVE_AVX2_KERNELS
 static const kernel_set avx2 = {mpmc_slabs_build_avx2, mpmc_p2g_avx2, mpmc_grid_update_avx2,
                                 mpmc_g2p_avx2, mpmc_fbar_avx2};
-#define KERNELS(sim) ((sim)->kernels == MPMC_KERNELS_AVX2 ? &avx2 : &baseline)
+static const kernel_set fused = {mpmc_slabs_build_fma, mpmc_p2g_fma, mpmc_grid_update_fma,
+                                 mpmc_g2p_fma, mpmc_fbar_fma};
+#define KERNELS(sim)                                  \
+  ((sim)->kernels == MPMC_KERNELS_FMA    ? &fused    \
+   : (sim)->kernels == MPMC_KERNELS_AVX2 ? &avx2     \
+                                         : &baseline)
 #else
 #define KERNELS(sim) (&baseline)
 #endif
