@@ -205,7 +205,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
  * fused scatter is race-free, or, when P2G scattered into one grid per thread, in P2G's
  * chunks, each thread scattering into its own copy of fb.  The scatter's form FB (g2p_point)
  * is chosen outside the loops: one form per loop body keeps the gather's sums in registers
- * (with the three forms inlined into one loop GCC spilled some, 20 instructions a point). */
+ * (with the three forms inlined into one loop GCC spilled some, 15 instructions a point). */
 #define G2P_CHUNKS(D, B, FBV)                                                                 \
   do {                                                                                        \
     const size_t per = sim->grid.nn * (size_t)((FBV) == 2 ? 2 : 1);                           \
