@@ -82,6 +82,18 @@ static const char *slurp(const char *path) {
   return buf;
 }
 
+/* The summary in out after n steps of free fall from rest at dt = 0.001 s (every stage of
+ * the scene): n steps, and the tip's u_y = -g dt^2 n (n + 1) / 2 (symplectic Euler) */
+static void expect_free_fall(const char *summary, int n, const char *what) {
+  const double g = 9.81, dt = 0.001;
+  const double steps = json_number(summary, "steps");
+  if (steps != n) fail_msg("%s: expected %d steps in all, got %g", what, n, steps);
+  const double expect = -g * dt * dt * n * (n + 1) / 2.0;
+  const double uy = json_number(summary, "tip_displacement_y");
+  if (fabs(uy - expect) > 1e-9 * fabs(expect))
+    fail_msg("%s: tip_displacement_y expected %.12g, got %.12g", what, expect, uy);
+}
+
 static void test_free_fall(void **state) {
   (void)state;
   const char *scene = DIR "/fall.yaml", *out = DIR "/out-fall";
@@ -92,16 +104,9 @@ static void test_free_fall(void **state) {
   TCALL(mpmc_workflow_run(ctx, scene, out, 0, NULL, MPMC_WORKFLOW_FORCE | MPMC_WORKFLOW_QUIET));
   test_ctx = NULL;
   mpmc_context_destroy(&ctx);
-  const double g = 9.81, dt = 0.001;
-  const int n = 100;
-  const double expect = -g * dt * dt * n * (n + 1) / 2.0;
-  const double uy = json_number(DIR "/out-fall/summary.json", "tip_displacement_y");
-  if (fabs(uy - expect) > 1e-9 * fabs(expect))
-    fail_msg("free fall: tip_displacement_y expected %.12g, got %.12g", expect, uy);
+  expect_free_fall(DIR "/out-fall/summary.json", 100, "free fall (2 stages of 0.05 s)");
   const double cx = json_number(DIR "/out-fall/summary.json", "center_of_mass_x");
   if (fabs(cx - 0.5) > 1e-12) fail_msg("free fall: center_of_mass_x expected 0.5, got %.15g", cx);
-  const double steps = json_number(DIR "/out-fall/summary.json", "steps");
-  if (steps != n) fail_msg("free fall: expected %d steps (2 stages of 0.05 s at dt = 0.001), got %g", n, steps);
   if (!exists(DIR "/out-fall/series.csv")) fail_msg("no series.csv");
   /* a box scene never maps libgmsh */
   FILE *maps = fopen("/proc/self/maps", "r");
@@ -167,14 +172,7 @@ static void test_check_and_resume(void **state) {
   snprintf(at, sizeof three - (size_t)(at - three), "  - {name: third, dt: 0.001, end: {time: 0.05}}\n%s", metrics);
   write_text(scene, three);
   if (run_cli("resume '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc resume with a third stage: expected exit 0");
-  const double steps = json_number(DIR "/out-resume/summary.json", "steps");
-  if (steps != 150) fail_msg("resume: expected 150 steps in all, got %g", steps);
-  const double g = 9.81, dt = 0.001;
-  const int n = 150;
-  const double expect = -g * dt * dt * n * (n + 1) / 2.0;
-  const double again = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
-  if (fabs(again - expect) > 1e-9 * fabs(expect))
-    fail_msg("resume: tip_displacement_y expected %.12g (three stages of free fall), got %.12g", expect, again);
+  expect_free_fall(DIR "/out-resume/summary.json", 150, "resume with a third stage");
   if (!strstr(slurp(DIR "/out-resume/summary.json"), "\"third\""))
     fail_msg("resume: summary.json names no stage 'third'");
   /* the last stage's end raised from 0.05 to 0.08 s: it goes on from where it ended */
@@ -183,21 +181,11 @@ static void test_check_and_resume(void **state) {
   memcpy(strstr(end, "0.05"), "0.08", 4);
   write_text(scene, three);
   if (run_cli("resume '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc resume with a later end: expected exit 0");
-  const double steps2 = json_number(DIR "/out-resume/summary.json", "steps");
-  if (steps2 != 180) fail_msg("resume to a later end: expected 180 steps in all, got %g", steps2);
-  const double expect2 = -g * dt * dt * 180 * 181 / 2.0;
-  const double uy2 = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
-  if (fabs(uy2 - expect2) > 1e-9 * fabs(expect2))
-    fail_msg("resume to a later end: tip_displacement_y expected %.12g, got %.12g", expect2, uy2);
+  expect_free_fall(DIR "/out-resume/summary.json", 180, "resume to a later end");
   /* a later end from the command line, after the run's own overrides: 20 steps more */
   if (run_cli("resume '" DIR "/out-resume' --set stages.third.end.time=0.1 --quiet") != 0)
     fail_msg("mpmc resume --set stages.third.end.time=0.1: expected exit 0");
-  const double steps3 = json_number(DIR "/out-resume/summary.json", "steps");
-  if (steps3 != 200) fail_msg("resume --set to a later end: expected 200 steps in all, got %g", steps3);
-  const double expect3 = -g * dt * dt * 200 * 201 / 2.0;
-  const double uy3 = json_number(DIR "/out-resume/summary.json", "tip_displacement_y");
-  if (fabs(uy3 - expect3) > 1e-9 * fabs(expect3))
-    fail_msg("resume --set to a later end: tip_displacement_y expected %.12g, got %.12g", expect3, uy3);
+  expect_free_fall(DIR "/out-resume/summary.json", 200, "resume --set to a later end");
   /* a bad override is named, and the outputs stay; --out does not apply to resume */
   snprintf(before, sizeof before, "%s", slurp(DIR "/out-resume/summary.json"));
   if (cli_output("resume '" DIR "/out-resume' --set stages.third.end.tme=1", msg, sizeof msg) == 0)
