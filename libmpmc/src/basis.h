@@ -8,15 +8,23 @@
 #include <string.h>
 
 #include "mpmc.h"
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #define MPMC_ALWAYS_INLINE static inline __attribute__((always_inline))
 #define MPMC_MAX_STENCIL 4
 
-/* floor(s) as an int for |s| < 2^31: truncation corrected below zero.  libm's floor needs
- * SSE4.1 to be inlined (not in the x86-64 baseline); this is three instructions. */
+/* floor(s) as an int for |s| < 2^31: with SSE4.1 (the AVX2 kernel sets) libm's floor,
+ * inlined as one rounding instruction; without it (the x86-64 baseline, where GCC calls
+ * libm) the truncation corrected below zero, three instructions.  The same value. */
 MPMC_ALWAYS_INLINE int mpmc_ifloor(double s) {
+#if defined(__SSE4_1__)
+  return (int)floor(s);
+#else
   const int i = (int)s;
   return i - (s < (double)i);
+#endif
 }
 
 /* nodes per axis in a point's support */
@@ -52,14 +60,20 @@ typedef int mpmc_b4i __attribute__((vector_size(4 * sizeof(int))));
 /* the same as mpmc_b4d in memory that is also read as doubles (the weight tables) */
 typedef double mpmc_b4da __attribute__((vector_size(4 * sizeof(double)), may_alias));
 
-/* floor per lane as doubles (|s| < 2^31), its int in *bi: truncation corrected below zero
- * (vectors through pointers: by value they would change the baseline build's ABI) */
+/* floor per lane as doubles (|s| < 2^31), its int in *bi: with AVX the rounding
+ * instruction, else truncation corrected below zero; the same values (vectors through
+ * pointers: by value they would change the baseline build's ABI) */
 MPMC_ALWAYS_INLINE void mpmc_floor4(const mpmc_b4d *s, mpmc_b4i *bi, mpmc_b4d *fl) {
+#if defined(__AVX__)
+  *fl = (mpmc_b4d)_mm256_floor_pd((__m256d)*s);
+  *bi = (mpmc_b4i)_mm256_cvttpd_epi32((__m256d)*fl);
+#else
   const mpmc_b4i i = __builtin_convertvector(*s, mpmc_b4i);
   const mpmc_b4d d = __builtin_convertvector(i, mpmc_b4d);
   const mpmc_b4l below = *s < d;
   *bi = i + __builtin_convertvector(below, mpmc_b4i);
   *fl = d - (mpmc_b4d)(below & (mpmc_b4l)(mpmc_b4d){1.0, 1.0, 1.0, 1.0});
+#endif
 }
 
 MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, double inv_h,
@@ -73,15 +87,25 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, 
   const mpmc_b4d lo = zero - l, hi = zero + l;
 /* lanes of a where mask m is set, else of b */
 #define SEL4_(m, a, b) ((mpmc_b4d)(((m) & (mpmc_b4l)(a)) | (~(m) & (mpmc_b4l)(b))))
-  const mpmc_b4d c0 = SEL4_(y < lo, lo, y), c = SEL4_(c0 > hi, hi, c0); /* y in [-l, l] */
+/* a > b ? a : b and a < b ? a : b per lane (NaN: b), as x86's max and min instructions */
+#if defined(__AVX__)
+#define MAX4_(a, b) ((mpmc_b4d)_mm256_max_pd((__m256d)(a), (__m256d)(b)))
+#define MIN4_(a, b) ((mpmc_b4d)_mm256_min_pd((__m256d)(a), (__m256d)(b)))
+#else
+#define MAX4_(a, b) SEL4_((a) > (b), a, b)
+#define MIN4_(a, b) SEL4_((a) < (b), a, b)
+#endif
+  const mpmc_b4d c0 = MAX4_(lo, y), c = MIN4_(hi, c0); /* y in [-l, l] */
   const mpmc_b4d a = l - c, e = l + c, t0 = lo - y, t2 = y - l;
   const mpmc_b4l sign = (mpmc_b4l)(mpmc_b4d){-0.0, -0.0, -0.0, -0.0}; /* the sign bits */
   const mpmc_b4d d = (mpmc_b4d)((mpmc_b4l)(y - c) & ~sign); /* |y - c| */
-  w[0] = a * a * i4l + SEL4_(t0 > zero, t0, zero);
+  w[0] = a * a * i4l + MAX4_(t0, zero);
   w[1] = one - (c * c + l * l) * i2l - d;
-  w[2] = e * e * i4l + SEL4_(t2 > zero, t2, zero);
+  w[2] = e * e * i4l + MAX4_(t2, zero);
   w[3] = zero;
 #undef SEL4_
+#undef MAX4_
+#undef MIN4_
   if (dw) {
     dw[0] = (zero - a) * gl;
     dw[1] = -2.0 * c * gl;
