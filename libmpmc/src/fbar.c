@@ -26,6 +26,9 @@
 #include <string.h>
 
 #include "transfer.h"
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 /* What point q scatters, (V^n, V^n j), V^n recovered as V0 J^{n+1} / dJ; leaves Jbar^n dJ
  * in Jbar until the gather (the denominator of eq 27). */
@@ -62,10 +65,28 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
     }
 }
 
-/* cbrt_near1's polynomial in e (e2 = e e), for scalars and for gather_scale4's vectors */
-#define CBRT_NEAR1_POLY(e, e2)                                                                \
-  ((1.0 + (e) * (1.0 / 3.0)) +                                                               \
-   (e2) * ((-1.0 / 9.0 + (e) * (5.0 / 81.0)) + (e2) * (-10.0 / 243.0 + (e) * (22.0 / 729.0))))
+/* a b + c: in the fma set one fused multiply-add (one rounding), elsewhere a product and a
+ * sum.  This file is compiled without contraction in every set (CMakeLists.txt), so that the
+ * gather's four-point path and its point-by-point path, which GCC would contract differently,
+ * give the same bits; the row sums, most of the gather's arithmetic, fuse explicitly here,
+ * alike in both. */
+#if defined(MPMC_ISA_FMA)
+#define MADD4V(a, b, c) ((mpmc_b4d)_mm256_fmadd_pd((__m256d)(a), (__m256d)(b), (__m256d)(c)))
+#define MADD(a, b, c) __builtin_fma(a, b, c)
+#else /* macros: a vector returned by value would change the baseline build's ABI (basis.h) */
+#define MADD4V(a, b, c) ((a) * (b) + (c))
+#define MADD(a, b, c) ((a) * (b) + (c))
+#endif
+#define MADD4(a, b, c) MADD4V(((mpmc_b4d){0.0, 0.0, 0.0, 0.0} + (a)), b, c)
+
+/* cbrt_near1's polynomial in e (e2 = e e), (1 + e/3) + e2 ((-1/9 + 5e/81) + e2 (-10/243 +
+ * 22e/729)), for scalars (M = MADD, C(c) = c) and for gather_scale4's vectors (MADD4V, C(c)
+ * the vector of c) */
+#define CBRT_NEAR1_POLY(e, e2, M, C)                                                          \
+  M(e2, M(e2, M(e, C(22.0 / 729.0), C(-10.0 / 243.0)), M(e, C(5.0 / 81.0), C(-1.0 / 9.0))),   \
+    M(e, C(1.0 / 3.0), C(1.0)))
+#define SCALAR_C(c) (c)
+#define VECTOR_C(c) ((mpmc_b4d){c, c, c, c})
 
 /* r^(1/3) for r near 1 (e = r - 1).  |e| < 0.004, the usual case: the Taylor polynomial to
  * e^5 (truncation below 1e-16) in Estrin's form, a short dependency chain; |e| < 0.05:
@@ -76,7 +97,7 @@ static inline double cbrt_near1(double r) {
   const double e = r - 1.0;
   if (fabs(e) < 0.004) {
     const double e2 = e * e;
-    return CBRT_NEAR1_POLY(e, e2);
+    return CBRT_NEAR1_POLY(e, e2, MADD, SCALAR_C);
   }
   if (!(fabs(e) < 0.05)) return cbrt(r);
   double y = 1.0 + e * (-1.0 / 3.0 + e * (2.0 / 9.0));
@@ -94,13 +115,14 @@ MPMC_ALWAYS_INLINE double projection_scale(mpmc_particles *p, const int DIM, int
   return DIM == 2 ? sqrt(r) : cbrt_near1(r);
 }
 
-/* The row sums of the gather, Pi = sum_i wx_i acc_i: every row of the stencil has the same
- * x-weights and a row's nodes are four contiguous doubles of fbj (those beyond the stencil
- * unused), so acc = sum_k wz_k (sum_j wy_j J_row(j,k)), one multiply-add per row and one
- * per plane of rows; wx, wy, wz the point's 1D weights (ws doubles apart). */
-MPMC_ALWAYS_INLINE double gather_rows(const mpmc_grid *g, const int DIM, const int BASIS,
-                                      size_t node0, const double *wx, const double *wy,
-                                      const double *wz, const int ws) {
+/* The row sums of the gather: every row of the stencil has the same x-weights and a row's
+ * nodes are four contiguous doubles of fbj (those beyond the stencil unused), so
+ * acc = sum_k wz_k (sum_j wy_j J_row(j,k)), one multiply-add per row and one per plane of
+ * rows, and Pi = sum_i wx_i acc_i (gather_dot); wy, wz the point's 1D weights (ws doubles
+ * apart). */
+MPMC_ALWAYS_INLINE void gather_rows(const mpmc_grid *g, const int DIM, const int BASIS,
+                                    size_t node0, const double *wy, const double *wz,
+                                    const int ws, mpmc_b4d *accp) {
   const int S = mpmc_stencil(BASIS);
   const double *restrict jb = g->fbj;
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
@@ -108,14 +130,20 @@ MPMC_ALWAYS_INLINE double gather_rows(const mpmc_grid *g, const int DIM, const i
   for (int k = 0; k < (DIM == 3 ? S : 1); ++k) {
     const double *r = jb + node0 + sz * (size_t)k;
     mpmc_b4d t = wy[0] * *(const mpmc_b4du *)r;
-    for (int j = 1; j < S; ++j) t += wy[j * ws] * *(const mpmc_b4du *)(r + sy * (size_t)j);
+    for (int j = 1; j < S; ++j) t = MADD4(wy[j * ws], *(const mpmc_b4du *)(r + sy * (size_t)j), t);
     if (DIM == 3)
-      acc += wz[k * ws] * t;
+      acc = MADD4(wz[k * ws], t, acc);
     else
       acc = t;
   }
-  double pi = wx[0] * acc[0];
-  for (int i = 1; i < S; ++i) pi += wx[i * ws] * acc[i];
+  *accp = acc;
+}
+
+/* Pi = sum_i wx_i acc_i, i in order: one point's (wx: its x-weights, ws doubles apart) */
+MPMC_ALWAYS_INLINE double gather_dot(const int BASIS, const double *wx, const int ws,
+                                     const mpmc_b4d *acc) {
+  double pi = wx[0] * (*acc)[0];
+  for (int i = 1; i < mpmc_stencil(BASIS); ++i) pi = MADD(wx[i * ws], (*acc)[i], pi);
   return pi;
 }
 
@@ -129,8 +157,9 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
   mpmc_pw pw;
   mpmc_point_weights(DIM, BASIS, 0, g, xs + (size_t)q * DIM,
                      BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
-  const double pi = gather_rows(g, DIM, BASIS, pw.node0, &pw.w[0][0], &pw.w[0][1], &pw.w[0][2], 4);
-  return projection_scale(p, DIM, q, pi, inv);
+  mpmc_b4d acc;
+  gather_rows(g, DIM, BASIS, pw.node0, &pw.w[0][1], &pw.w[0][2], 4, &acc);
+  return projection_scale(p, DIM, q, gather_dot(BASIS, &pw.w[0][0], 4, &acc), inv);
 }
 
 /* The 1D weights of four consecutive points q .. q + 3 at x^n = xs, lanes the points:
@@ -139,7 +168,7 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
  * instructions of four calls of it. */
 typedef struct {
   double w[3][MPMC_MAX_STENCIL][4] __attribute__((aligned(32)));
-  size_t node0[4];
+  long long node0[4];
 } pw4;
 
 MPMC_ALWAYS_INLINE void point_weights4(const int DIM, const int BASIS, const mpmc_grid *g,
@@ -158,31 +187,51 @@ MPMC_ALWAYS_INLINE void point_weights4(const int DIM, const int BASIS, const mpm
       mpmc_poly_lanes(BASIS, &s, &b[a], (mpmc_b4da *)t->w[a]);
     }
   }
-  /* the linear indices in doubles (exact: below 2^53), one conversion a point */
+  /* the linear indices in doubles (exact: below 2^52), to integers by the bits of
+   * nd + 2^52 less those of 2^52 (the indices are not negative) */
   const mpmc_b4d nd = __builtin_convertvector(b[0], mpmc_b4d) +
                       (double)g->n[0] * (__builtin_convertvector(b[1], mpmc_b4d) +
                                          (double)g->n[1] * __builtin_convertvector(b[2], mpmc_b4d));
-  for (int l = 0; l < 4; ++l) t->node0[l] = (size_t)nd[l];
+  const mpmc_b4d two52 = {0x1p52, 0x1p52, 0x1p52, 0x1p52};
+  const mpmc_b4l ni = (mpmc_b4l)(nd + two52) - (mpmc_b4l)two52;
+  memcpy(t->node0, &ni, sizeof ni);
 }
 
 /* gather_scale for the four points q .. q + 3 of t into scale[0..3], each lane with the
- * same operations as one point alone (same bits): the reciprocals and the cube roots near 1
- * as vectors, the rest lane by lane. */
+ * same operations as one point alone (same bits): the row sums point by point, then, with
+ * them transposed, gather_dot, the reciprocals and the cube roots near 1 as vectors. */
 MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BASIS, const pw4 *t,
                                       int q, double *scale) {
   mpmc_particles *p = &sim->p;
   const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
-  mpmc_b4d pi;
+  mpmc_b4d a[4];
   for (int l = 0; l < 4; ++l)
-    pi[l] = gather_rows(&sim->grid, DIM, BASIS, t->node0[l], &t->w[0][0][l], &t->w[1][0][l],
-                        &t->w[2][0][l], 4);
+    gather_rows(&sim->grid, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l], 4, &a[l]);
+  /* c[i] = (a[0][i], .., a[3][i]): lanes the points, as t's weights */
+  typedef long long ix4 __attribute__((vector_size(4 * sizeof(long long))));
+  const mpmc_b4d e0 = __builtin_shuffle(a[0], a[1], (ix4){0, 4, 2, 6}),
+                 o0 = __builtin_shuffle(a[0], a[1], (ix4){1, 5, 3, 7}),
+                 e1 = __builtin_shuffle(a[2], a[3], (ix4){0, 4, 2, 6}),
+                 o1 = __builtin_shuffle(a[2], a[3], (ix4){1, 5, 3, 7});
+  const mpmc_b4d c[4] = {__builtin_shuffle(e0, e1, (ix4){0, 1, 4, 5}),
+                         __builtin_shuffle(o0, o1, (ix4){0, 1, 4, 5}),
+                         __builtin_shuffle(e0, e1, (ix4){2, 3, 6, 7}),
+                         __builtin_shuffle(o0, o1, (ix4){2, 3, 6, 7})};
+  const mpmc_b4da *wx = (const mpmc_b4da *)t->w[0];
+  mpmc_b4d pi = wx[0] * c[0];
+  for (int i = 1; i < mpmc_stencil(BASIS); ++i) pi = MADD4V(wx[i], c[i], pi);
   *(mpmc_b4du *)(p->Jbar + q) = pi;
   const mpmc_b4d r = pi * inv, e = r - 1.0;
   const mpmc_b4l magn = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX}; /* all but the sign */
   const mpmc_b4l small = (mpmc_b4d)((mpmc_b4l)e & magn) < 0.004;       /* |e| < 0.004, not NaN */
-  if (DIM == 3 && small[0] & small[1] & small[2] & small[3]) { /* cbrt_near1's first branch */
+#if defined(__AVX__)
+  const int all_small = _mm256_movemask_pd((__m256d)small) == 15;
+#else
+  const int all_small = small[0] & small[1] & small[2] & small[3];
+#endif
+  if (DIM == 3 && all_small) { /* cbrt_near1's first branch in every lane */
     const mpmc_b4d e2 = e * e;
-    *(mpmc_b4du *)scale = CBRT_NEAR1_POLY(e, e2);
+    *(mpmc_b4du *)scale = CBRT_NEAR1_POLY(e, e2, MADD4V, VECTOR_C);
   } else {
     for (int l = 0; l < 4; ++l) scale[l] = DIM == 2 ? sqrt(r[l]) : cbrt_near1(r[l]);
   }
