@@ -31,11 +31,45 @@
  * second places them.  Each point's plane is kept in between in dF, which is free from the
  * end of one step's material update until its G2P (sort.c uses it likewise).  The order
  * does not depend on the chunks, so neither on the thread count. */
+/* The first pass over points q0 .. q1 - 1 (one chunk): the box of their cells into box
+ * (lo[3], hi[3]), each point's plane along axis ax into plane, the points per plane added to
+ * ct; DIM a constant, so that the axes unroll. */
+MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const double *xs, int q0,
+                                    int q1, int ax, int *restrict plane, int *restrict ct,
+                                    int *restrict box) {
+  int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
+  double o[3] = {0.0, 0.0, 0.0};
+  for (int a = 0; a < DIM; ++a) o[a] = g->origin[a];
+  const double ih = g->inv_h;
+  int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
+  for (int q = q0; q < q1; ++q) {
+    const double *x = xs + (size_t)q * DIM;
+    int c[3] = {0, 0, 0};
+    for (int a = 0; a < DIM; ++a) {
+      c[a] = (int)((x[a] - o[a]) * ih);
+      lo[a] = c[a] < lo[a] ? c[a] : lo[a];
+      hi[a] = c[a] > hi[a] ? c[a] : hi[a];
+    }
+    const int pl = ax == 0 ? c[0] : ax == 1 ? c[1] : c[2];
+    plane[q] = pl;
+    if (pl != cur) {
+      if (run) ct[cur] += run;
+      cur = pl;
+      run = 0;
+    }
+    ++run;
+  }
+  if (run) ct[cur] += run;
+  for (int a = 0; a < 3; ++a) {
+    box[a] = lo[a];
+    box[3 + a] = hi[a];
+  }
+}
+
 int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim, n = p->n;
-  const double ih = g->inv_h;
   if (n == 0) {
     for (int a = 0; a < 3; ++a) g->act_lo[a] = g->act_hi[a] = 0;
     sim->nslab = 0;
@@ -74,33 +108,13 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
      * inside the ghost layers, so the cell coordinates are positive) and the plane counts */
 #pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
     for (int t = 0; t < nc; ++t) {
-      int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
       int *ct = cnt + (size_t)t * nmax;
       for (int k = 0; k < nmax; ++k) ct[k] = 0;
       const int q0 = mpmc_chunk_start(n, t, nc), q1 = mpmc_chunk_start(n, t + 1, nc);
-      int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
-      for (int q = q0; q < q1; ++q) {
-        const double *x = p->x + (size_t)q * d;
-        for (int a = 0; a < d; ++a) {
-          const int c = (int)((x[a] - g->origin[a]) * ih);
-          lo[a] = c < lo[a] ? c : lo[a];
-          hi[a] = c > hi[a] ? c : hi[a];
-          if (a == ax) {
-            plane[q] = c;
-            if (c != cur) {
-              if (run) ct[cur] += run;
-              cur = c;
-              run = 0;
-            }
-            ++run;
-          }
-        }
-      }
-      if (run) ct[cur] += run;
-      for (int a = 0; a < 3; ++a) {
-        box[6 * t + a] = lo[a];
-        box[6 * t + 3 + a] = hi[a];
-      }
+      if (d == 3)
+        count_chunk(3, g, p->x, q0, q1, ax, plane, ct, box + 6 * t);
+      else
+        count_chunk(2, g, p->x, q0, q1, ax, plane, ct, box + 6 * t);
     }
     for (int a = 0; a < d; ++a) {
       clo[a] = INT_MAX;
