@@ -70,14 +70,15 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
  * gather's four-point path and its point-by-point path, which GCC would contract differently,
  * give the same bits; the row sums, most of the gather's arithmetic, fuse explicitly here,
  * alike in both. */
-#if defined(MPMC_ISA_FMA)
+#if defined(MPMC_ISA_FMA) /* MADD4: a a scalar */
 #define MADD4V(a, b, c) ((mpmc_b4d)_mm256_fmadd_pd((__m256d)(a), (__m256d)(b), (__m256d)(c)))
+#define MADD4(a, b, c) MADD4V(_mm256_set1_pd(a), b, c)
 #define MADD(a, b, c) __builtin_fma(a, b, c)
 #else /* macros: a vector returned by value would change the baseline build's ABI (basis.h) */
 #define MADD4V(a, b, c) ((a) * (b) + (c))
+#define MADD4(a, b, c) ((a) * (b) + (c))
 #define MADD(a, b, c) ((a) * (b) + (c))
 #endif
-#define MADD4(a, b, c) MADD4V(((mpmc_b4d){0.0, 0.0, 0.0, 0.0} + (a)), b, c)
 
 /* cbrt_near1's polynomial in e (e2 = e e), (1 + e/3) + e2 ((-1/9 + 5e/81) + e2 (-10/243 +
  * 22e/729)), for scalars (M = MADD, C(c) = c) and for gather_scale4's vectors (MADD4V, C(c)
