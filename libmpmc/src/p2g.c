@@ -41,9 +41,23 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
   double o[3] = {0.0, 0.0, 0.0};
   for (int a = 0; a < DIM; ++a) o[a] = g->origin[a];
   const double ih = g->inv_h;
+#if defined(__AVX2__) /* the axes in the lanes of one vector: the same operations per lane */
+  const __m256i in = _mm256_set_epi64x(0, DIM == 3 ? -1 : 0, -1, -1); /* the point's axes */
+  const __m256d ov = _mm256_set_pd(0.0, o[2], o[1], o[0]), ihv = _mm256_set1_pd(ih);
+  const __m128i axv = _mm_set1_epi32(ax);
+  __m128i lov = _mm_set1_epi32(INT_MAX), hiv = _mm_set1_epi32(-1);
+#endif
   int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
   for (int q = q0; q < q1; ++q) {
     const double *x = xs + (size_t)q * DIM;
+#if defined(__AVX2__)
+    const __m128i cv = _mm256_cvttpd_epi32(
+        _mm256_mul_pd(_mm256_sub_pd(_mm256_maskload_pd(x, in), ov), ihv));
+    lov = _mm_min_epi32(lov, cv);
+    hiv = _mm_max_epi32(hiv, cv);
+    const int pl = _mm_cvtsi128_si32(
+        _mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(cv), axv)));
+#else
     int c[3] = {0, 0, 0};
     for (int a = 0; a < DIM; ++a) {
       c[a] = (int)((x[a] - o[a]) * ih);
@@ -51,6 +65,7 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
       hi[a] = c[a] > hi[a] ? c[a] : hi[a];
     }
     const int pl = ax == 0 ? c[0] : ax == 1 ? c[1] : c[2];
+#endif
     plane[q] = pl;
     if (pl != cur) {
       if (run) ct[cur] += run;
@@ -60,6 +75,15 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
     ++run;
   }
   if (run) ct[cur] += run;
+#if defined(__AVX2__)
+  int lv[4], hv[4];
+  _mm_storeu_si128((__m128i *)lv, lov);
+  _mm_storeu_si128((__m128i *)hv, hiv);
+  for (int a = 0; a < DIM; ++a) {
+    lo[a] = lv[a];
+    hi[a] = hv[a];
+  }
+#endif
   for (int a = 0; a < 3; ++a) {
     box[a] = lo[a];
     box[3 + a] = hi[a];
