@@ -70,7 +70,7 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
  * gather's four-point path and its point-by-point path, which GCC would contract differently,
  * give the same bits; the row sums, most of the gather's arithmetic, fuse explicitly here,
  * alike in both. */
-#if defined(MPMC_ISA_FMA) /* MADD4: a a scalar */
+#if defined(MPMC_ISA_FMA) /* MADD4V: a a vector; MADD4: a a scalar */
 #define MADD4V(a, b, c) ((mpmc_b4d)_mm256_fmadd_pd((__m256d)(a), (__m256d)(b), (__m256d)(c)))
 #define MADD4(a, b, c) MADD4V(_mm256_set1_pd(a), b, c)
 #define MADD(a, b, c) __builtin_fma(a, b, c)
@@ -207,17 +207,17 @@ MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BAS
   const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
   mpmc_b4d a[4];
   for (int l = 0; l < 4; ++l)
-    gather_rows(&sim->grid, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l], 4, &a[l]);
+    gather_rows(&sim->grid, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l],
+                4, &a[l]);
   /* c[i] = (a[0][i], .., a[3][i]): lanes the points, as t's weights */
-  typedef long long ix4 __attribute__((vector_size(4 * sizeof(long long))));
-  const mpmc_b4d e0 = __builtin_shuffle(a[0], a[1], (ix4){0, 4, 2, 6}),
-                 o0 = __builtin_shuffle(a[0], a[1], (ix4){1, 5, 3, 7}),
-                 e1 = __builtin_shuffle(a[2], a[3], (ix4){0, 4, 2, 6}),
-                 o1 = __builtin_shuffle(a[2], a[3], (ix4){1, 5, 3, 7});
-  const mpmc_b4d c[4] = {__builtin_shuffle(e0, e1, (ix4){0, 1, 4, 5}),
-                         __builtin_shuffle(o0, o1, (ix4){0, 1, 4, 5}),
-                         __builtin_shuffle(e0, e1, (ix4){2, 3, 6, 7}),
-                         __builtin_shuffle(o0, o1, (ix4){2, 3, 6, 7})};
+  const mpmc_b4d e0 = __builtin_shuffle(a[0], a[1], (mpmc_b4l){0, 4, 2, 6}),
+                 o0 = __builtin_shuffle(a[0], a[1], (mpmc_b4l){1, 5, 3, 7}),
+                 e1 = __builtin_shuffle(a[2], a[3], (mpmc_b4l){0, 4, 2, 6}),
+                 o1 = __builtin_shuffle(a[2], a[3], (mpmc_b4l){1, 5, 3, 7});
+  const mpmc_b4d c[4] = {__builtin_shuffle(e0, e1, (mpmc_b4l){0, 1, 4, 5}),
+                         __builtin_shuffle(o0, o1, (mpmc_b4l){0, 1, 4, 5}),
+                         __builtin_shuffle(e0, e1, (mpmc_b4l){2, 3, 6, 7}),
+                         __builtin_shuffle(o0, o1, (mpmc_b4l){2, 3, 6, 7})};
   const mpmc_b4da *wx = (const mpmc_b4da *)t->w[0];
   mpmc_b4d pi = wx[0] * c[0];
   for (int i = 1; i < mpmc_stencil(BASIS); ++i) pi = MADD4V(wx[i], c[i], pi);

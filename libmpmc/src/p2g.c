@@ -11,27 +11,7 @@
 
 #include "transfer.h"
 
-/* Bucket the points into slabs of whole cell planes along one axis (a counting sort of
- * indices, by plane and within a plane by index; the particle arrays themselves are not
- * moved here: sort.c does that, every sort_interval steps when the caller asks for it), and
- * set the grid's active box to the nodes the points' stencils reach.  Visiting a plane's
- * points in index order (particle arrays in order, grid at random when the points are
- * shuffled) was faster than by cell (grid in order, particle arrays at random) on the 3D
- * column; sorted points are in both orders at once.
- * Slabs of one parity run in parallel: a point in cell c touches nodes c-1 .. c+2 at most
- * (cubic), so two slabs with one slab of at least MPMC_SLAB_W = 3 cells between them share no
- * node.  The slab boundaries balance the points: about 2 x threads slabs or a multiple, so
- * each thread gets the same share of each colour (fixed-width slabs left one of two threads
- * idle for a third of P2G in the 3D column).  Results depend on the thread count only
- * through the summation order at the nodes that two slabs share (at every node when the
- * threads scatter into grids of their own, private_grids).
- * Both passes over the points run on all threads, each over a fixed chunk of them: the
- * first finds the box and counts the points per plane of the slab axis (the last step's
- * axis; counted again in the rare step where mpmc_slab_axis picks another for the box), the
- * second places them.  Each point's plane is kept in between in dF, which is free from the
- * end of one step's material update until its G2P (sort.c uses it likewise).  The order
- * does not depend on the chunks, so neither on the thread count. */
-/* The first pass over points q0 .. q1 - 1 (one chunk): the box of their cells into box
+/* mpmc_slabs_build's first pass over points q0 .. q1 - 1 (one chunk): their cells' box into box
  * (lo[3], hi[3]), each point's plane along axis ax into plane, the points per plane added to
  * ct; DIM a constant, so that the axes unroll. */
 MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const double *xs, int q0,
@@ -90,6 +70,26 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
   }
 }
 
+/* Bucket the points into slabs of whole cell planes along one axis (a counting sort of
+ * indices, by plane and within a plane by index; the particle arrays themselves are not
+ * moved here: sort.c does that, every sort_interval steps when the caller asks for it), and
+ * set the grid's active box to the nodes the points' stencils reach.  Visiting a plane's
+ * points in index order (particle arrays in order, grid at random when the points are
+ * shuffled) was faster than by cell (grid in order, particle arrays at random) on the 3D
+ * column; sorted points are in both orders at once.
+ * Slabs of one parity run in parallel: a point in cell c touches nodes c-1 .. c+2 at most
+ * (cubic), so two slabs with one slab of at least MPMC_SLAB_W = 3 cells between them share no
+ * node.  The slab boundaries balance the points: about 2 x threads slabs or a multiple, so
+ * each thread gets the same share of each colour (fixed-width slabs left one of two threads
+ * idle for a third of P2G in the 3D column).  Results depend on the thread count only
+ * through the summation order at the nodes that two slabs share (at every node when the
+ * threads scatter into grids of their own, private_grids).
+ * Both passes over the points run on all threads, each over a fixed chunk of them: the
+ * first finds the box and counts the points per plane of the slab axis (the last step's
+ * axis; counted again in the rare step where mpmc_slab_axis picks another for the box), the
+ * second places them.  Each point's plane is kept in between in dF, which is free from the
+ * end of one step's material update until its G2P (sort.c uses it likewise).  The order
+ * does not depend on the chunks, so neither on the thread count. */
 int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
