@@ -135,25 +135,43 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, 
   } while (0)
 
 /* The linear and B-spline weights in the lanes of s = (x_p - origin)/h (four points along
- * one axis: fbar.c's gather), the floor exact as mpmc_basis_1d's; no gradients. */
-MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, mpmc_b4i *base,
-                                        mpmc_b4da *w) {
-  const mpmc_b4d s = *sp;
+ * one axis), the floor exact as mpmc_basis_1d's, and with dw (may be a constant NULL) their
+ * gradients: mpmc_basis_1d's operations per lane, so the same bits. */
+MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, double inv_h,
+                                        mpmc_b4i *base, mpmc_b4da *w, mpmc_b4da *dw) {
+  const mpmc_b4d s = *sp, zero = {0.0, 0.0, 0.0, 0.0};
   mpmc_b4d fl;
   if (basis == MPMC_BASIS_LINEAR) {
     mpmc_floor4(&s, base, &fl);
     const mpmc_b4d f = s - fl;
     MPMC_LINEAR_W(mpmc_b4d, f, w);
+    if (dw) {
+      dw[0] = zero - inv_h;
+      dw[1] = zero + inv_h;
+    }
   } else if (basis == MPMC_BASIS_BSPLINE2) {
     const mpmc_b4d sh = s - 0.5;
     mpmc_floor4(&sh, base, &fl);
     const mpmc_b4d f = s - fl;
     MPMC_BSPLINE2_W(mpmc_b4d, f, w);
+    if (dw) {
+      const mpmc_b4d x1 = f - 1.0;
+      dw[0] = -(1.5 - f) * inv_h;
+      dw[1] = -2.0 * x1 * inv_h;
+      dw[2] = (f - 0.5) * inv_h;
+    }
   } else { /* cubic */
     mpmc_floor4(&s, base, &fl);
     *base -= 1;
     const mpmc_b4d f = s - (fl - 1.0);
     MPMC_BSPLINE3_W(mpmc_b4d, f, w);
+    if (dw) {
+      const mpmc_b4d x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
+      dw[0] = -0.5 * x0 * x0 * inv_h;
+      dw[1] = (1.5 * x1 * x1 - 2.0 * x1) * inv_h;
+      dw[2] = -(1.5 * x2 * x2 - 2.0 * x2) * inv_h;
+      dw[3] = 0.5 * x3 * x3 * inv_h;
+    }
   }
 }
 

@@ -163,46 +163,11 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
   return projection_scale(p, DIM, q, gather_dot(BASIS, &pw.w[0][0], 4, &acc), inv);
 }
 
-/* The 1D weights of four consecutive points q .. q + 3 at x^n = xs, lanes the points:
- * w[a][k] the k-th node along axis a, node0 each point's first stencil node.  The same
- * operations per lane as mpmc_point_weights per point (same bits), a third of the
- * instructions of four calls of it. */
-typedef struct {
-  double w[3][MPMC_MAX_STENCIL][4] __attribute__((aligned(32)));
-  long long node0[4];
-} pw4;
-
-MPMC_ALWAYS_INLINE void point_weights4(const int DIM, const int BASIS, const mpmc_grid *g,
-                                       const mpmc_particles *p, const double *xs, int q,
-                                       pw4 *t) {
-  mpmc_b4i b[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
-  const double *x = xs + (size_t)q * DIM;
-  for (int a = 0; a < DIM; ++a) {
-    const mpmc_b4d xv = {x[a], x[DIM + a], x[2 * DIM + a], x[3 * DIM + a]};
-    const mpmc_b4d s = (xv - g->origin[a]) * g->inv_h;
-    if (BASIS == MPMC_BASIS_UGIMP) {
-      const double *l = p->lp + q;
-      const mpmc_b4d lv = (mpmc_b4d){l[0], l[1], l[2], l[3]} * g->inv_h;
-      mpmc_ugimp_axes(&s, &lv, g->inv_h, &b[a], (mpmc_b4da *)t->w[a], NULL);
-    } else {
-      mpmc_poly_lanes(BASIS, &s, &b[a], (mpmc_b4da *)t->w[a]);
-    }
-  }
-  /* the linear indices in doubles (exact: below 2^52), to integers by the bits of
-   * nd + 2^52 less those of 2^52 (the indices are not negative) */
-  const mpmc_b4d nd = __builtin_convertvector(b[0], mpmc_b4d) +
-                      (double)g->n[0] * (__builtin_convertvector(b[1], mpmc_b4d) +
-                                         (double)g->n[1] * __builtin_convertvector(b[2], mpmc_b4d));
-  const mpmc_b4d two52 = {0x1p52, 0x1p52, 0x1p52, 0x1p52};
-  const mpmc_b4l ni = (mpmc_b4l)(nd + two52) - (mpmc_b4l)two52;
-  memcpy(t->node0, &ni, sizeof ni);
-}
-
 /* gather_scale for the four points q .. q + 3 of t into scale[0..3], each lane with the
  * same operations as one point alone (same bits): the row sums point by point, then, with
  * them transposed, gather_dot, the reciprocals and the cube roots near 1 as vectors. */
-MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BASIS, const pw4 *t,
-                                      int q, double *scale) {
+MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BASIS,
+                                      const mpmc_pw4 *t, int q, double *scale) {
   mpmc_particles *p = &sim->p;
   const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
   mpmc_b4d a[4];
@@ -297,8 +262,9 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
       for (; q + 4 <= q1; q += 4) {                                                          \
         if (!one && mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id) \
           continue;                                                                          \
-        pw4 t;                                                                               \
-        point_weights4(D, B, &sim->grid, &sim->p, xs, q, &t);                                \
+        const int idx[4] = {q, q + 1, q + 2, q + 3};                                         \
+        mpmc_pw4 t; /* the same bits as mpmc_point_weights per point */                      \
+        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t);                    \
         if (one || (mat[q] == id && mat[q + 1] == id && mat[q + 2] == id && mat[q + 3] == id)) \
           gather_scale4(sim, D, B, &t, q, scale + (q - q0));                                 \
         else /* materials mixed: the others' scale and Jbar left alone */                    \

@@ -5,6 +5,11 @@
  * the paper and total forms only of V^n j: P2G scattered V^n, p2g.c). */
 #include <limits.h>
 #include <math.h>
+#ifdef _OPENMP
+#include <omp.h>
+#else
+#define omp_get_max_threads() 1
+#endif
 
 #include "transfer.h"
 #if defined(__AVX2__)
@@ -40,7 +45,8 @@ MPMC_ALWAYS_INLINE void fb_row(const int S, const int WIDE, double *restrict f,
   }
 }
 
-/* Algorithm 1 step 3's scatter of V^n j (vj) into fbj with the weights pw:
+/* Algorithm 1 step 3's scatter of V^n j (vj) into fbj with a point's weights W (lane of a
+ * mpmc_pw4, node k of axis a at W[MPMC_PW4_AXIS a + 4 k]) from node0:
  * fbj_i += ((w_x vj) w_z) w_y, per plane of rows the x-weights times vj times w_z as one
  * vector, then per row one vector multiply and add (fbar.c's scatter_point the same).
  * WIDE: rows of three nodes as four (the fourth plus 0), where the node after a row is
@@ -48,17 +54,16 @@ MPMC_ALWAYS_INLINE void fb_row(const int S, const int WIDE, double *restrict f,
  * one of this slab's, which no point of a slab of the same colour reaches; it is in the same
  * grid row (a stencil ends at least one node before a row's last ghost node). */
 MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WIDE,
-                                   const mpmc_grid *g, double *restrict fb, const mpmc_pw *pw,
-                                   double vj) {
-  const int S = mpmc_stencil(BASIS);
+                                   const mpmc_grid *g, double *restrict fb, const double *W,
+                                   size_t node0, double vj) {
+  const int S = mpmc_stencil(BASIS), AX = MPMC_PW4_AXIS;
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
-  const mpmc_b4d wxv = (mpmc_b4d){pw->w[0][0], pw->w[1][0], S > 2 ? pw->w[2][0] : 0.0,
-                                  S > 3 ? pw->w[3][0] : 0.0} * vj;
+  const mpmc_b4d wxv = (mpmc_b4d){W[0], W[4], S > 2 ? W[8] : 0.0, S > 3 ? W[12] : 0.0} * vj;
   for (int k = 0; k < (DIM == 3 ? S : 1); ++k) {
-    const mpmc_b4d wzv = DIM == 3 ? wxv * pw->w[k][2] : wxv;
-    double *f = fb + pw->node0 + sz * (size_t)k;
+    const mpmc_b4d wzv = DIM == 3 ? wxv * W[2 * AX + 4 * k] : wxv;
+    double *f = fb + node0 + sz * (size_t)k;
     for (int j = 0; j < S; ++j) {
-      const mpmc_b4d add = wzv * pw->w[j][1];
+      const mpmc_b4d add = wzv * W[AX + 4 * j];
       fb_row(S, WIDE, f + sy * (size_t)j, &add);
     }
   }
@@ -74,14 +79,13 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
  * (transfer.h); either way the caller runs the points in slab colours. */
 MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, const int FB,
                                  double dt, const g2p_ctx *c, double *restrict fb, int q,
-                                 double *v2max) {
+                                 const mpmc_pw4 *t, int l, double *v2max) {
   mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
-  const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
+  const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC, AX = MPMC_PW4_AXIS;
   const double *restrict rec = g->node;
-  const size_t qd = (size_t)q * DIM;
-  mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, 1, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  const size_t qd = (size_t)q * DIM, node0 = (size_t)t->node0[l];
+  const double *W = &t->w[0][0][l], *DW = &t->dw[0][0][l]; /* node k, axis a: [AX a + 4 k] */
   const mpmc_vd zero = {0.0}; /* the other lanes zero as well */
   /* With 2-wide vectors the whole record's sums and accumulators (16 vectors) overflow the
    * 16 SSE registers: the first sweep then takes the velocity half (v_pic, L) and the second
@@ -103,14 +107,14 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       mpmc_vd sw[MPMC_NV], sd[MPMC_NC];
       for (int k = 0; k < N1; ++k) sw[k] = zero;
       for (int k = 0; k < NC; ++k) sd[k] = zero;
-      const double *restrict r = rec + (pw.node0 + sy * (size_t)j + sz * (size_t)kz) * R;
+      const double *restrict r = rec + (node0 + sy * (size_t)j + sz * (size_t)kz) * R;
       for (int i = 0; i < S; ++i) {
-        const double wx = pw.w[i][0], dx = pw.dw[i][0];
+        const double wx = W[4 * i], dx = DW[4 * i];
         const double *ri = r + i * R;
         for (int k = 0; k < N1; ++k) sw[k] += wx * MPMC_VC(ri + MPMC_VW * k);
         for (int k = 0; k < NC; ++k) sd[k] += dx * MPMC_VC(ri + MPMC_VW * k);
       }
-      const double wy = pw.w[j][1], dy = pw.dw[j][1];
+      const double wy = W[AX + 4 * j], dy = DW[AX + 4 * j];
       for (int k = 0; k < N1; ++k) P[k] += wy * sw[k];
       for (int k = 0; k < NC; ++k) {
         Pd[k] += wy * sd[k];
@@ -118,7 +122,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       }
     }
     if (DIM == 3) {
-      const double wz = pw.w[kz][2], dz = pw.dw[kz][2];
+      const double wz = W[2 * AX + 4 * kz], dz = DW[2 * AX + 4 * kz];
       for (int k = 0; k < N1; ++k) A[k] += wz * P[k];
       for (int k = 0; k < NC; ++k) {
         B0[k] += wz * Pd[k];
@@ -161,7 +165,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     mpmc_stable_weights(DIM, BASIS, g, p->x + qd, &sp);
     MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
   }
-  if (FB == 1 || FB == 3) fb_scatter(DIM, BASIS, FB == 3, g, fb, &pw, vj);
+  if (FB == 1 || FB == 3) fb_scatter(DIM, BASIS, FB == 3, g, fb, W, node0, vj);
   if (SPLIT) /* the increment half, factored as above */
     for (int kz = 0; kz < (DIM == 3 ? S : 1); ++kz) {
       mpmc_vd P[MPMC_NV];
@@ -169,14 +173,14 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       for (int j = 0; j < S; ++j) {
         mpmc_vd sw[MPMC_NV];
         for (int k = N1; k < NV; ++k) sw[k] = zero;
-        const double *restrict r = rec + (pw.node0 + sy * (size_t)j + sz * (size_t)kz) * R;
+        const double *restrict r = rec + (node0 + sy * (size_t)j + sz * (size_t)kz) * R;
         for (int i = 0; i < S; ++i) {
-          const double wx = pw.w[i][0];
+          const double wx = W[4 * i];
           for (int k = N1; k < NV; ++k) sw[k] += wx * MPMC_VC(r + i * R + MPMC_VW * k);
         }
-        for (int k = N1; k < NV; ++k) P[k] += pw.w[j][1] * sw[k];
+        for (int k = N1; k < NV; ++k) P[k] += W[AX + 4 * j] * sw[k];
       }
-      for (int k = N1; k < NV; ++k) A[k] += (DIM == 3 ? pw.w[kz][2] : 1.0) * P[k];
+      for (int k = N1; k < NV; ++k) A[k] += (DIM == 3 ? W[2 * AX + 4 * kz] : 1.0) * P[k];
     }
   /* A = (., v_pic | dv) */
   double vpic[3], dv[3];
@@ -213,9 +217,10 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int t = 0; t < nc; ++t) {                                                            \
       double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                     \
       const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                                  \
-      for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1_; ++k)                           \
-        if (!g2p_point(sim, D, B, FBV, dt, c, f_, order[k], &v2m) && order[k] < first_bad)    \
-          first_bad = order[k];                                                               \
+      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order,                          \
+                    mpmc_chunk_start(sim->p.n, t, nc), k1_, q, l, w4,                         \
+                    if (!g2p_point(sim, D, B, FBV, dt, c, f_, q, &w4, l, &v2m) && q < first_bad) \
+                      first_bad = q);                                                         \
     }                                                                                         \
   } while (0)
 #define G2P_SLABS(D, B, FBV)                                                                  \
@@ -223,18 +228,24 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int colour = 0; colour < 2; ++colour) {                                              \
       _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                         \
-        for (int k = start[sl]; k < start[sl + 1]; ++k)                                       \
-          if (!g2p_point(sim, D, B, FBV, dt, c, fb0, order[k], &v2m) && order[k] < first_bad) \
-            first_bad = order[k];                                                             \
+        MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order, start[sl],             \
+                      start[sl + 1], q, l, w4,                                                \
+                      if (!g2p_point(sim, D, B, FBV, dt, c, fb0, q, &w4, l, &v2m) &&          \
+                          q < first_bad) first_bad = q);                                      \
     }                                                                                         \
   } while (0)
 #define G2P_KERNEL(D, B)                                                                      \
   static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad, double *vm) { \
     int first_bad = INT_MAX;                                                                  \
     double v2m = 0.0;                                                                         \
-    _Pragma("omp parallel for schedule(static) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
-    for (int q = 0; q < sim->p.n; ++q)                                                        \
-      if (!g2p_point(sim, D, B, 0, dt, c, NULL, q, &v2m) && q < first_bad) first_bad = q;     \
+    const int nc = sim->p.n > MPMC_OMP_MIN ? omp_get_max_threads() : 1; /* chunks */         \
+    _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) reduction(max : v2m) num_threads(nc)") \
+    for (int t = 0; t < nc; ++t)                                                              \
+      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, (const int *)NULL,              \
+                    mpmc_chunk_start(sim->p.n, t, nc), mpmc_chunk_start(sim->p.n, t + 1, nc), \
+                    q, l, w4,                                                                 \
+                    if (!g2p_point(sim, D, B, 0, dt, c, NULL, q, &w4, l, &v2m) &&             \
+                        q < first_bad) first_bad = q);                                        \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                             \
     *vm = v2m;                                                                                \
   }                                                                                           \

@@ -231,13 +231,12 @@ MPMC_ALWAYS_INLINE double rec_slot(const int DIM, int s, double m, const double 
  * plane of rows, c and e once per row: per node a few whole-vector multiply-adds on one
  * record. */
 MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
-                                   double *restrict rec, int q) {
+                                   double *restrict rec, int q, const mpmc_pw4 *t, int l) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
-  const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC;
+  const int R = MPMC_NREC, S = mpmc_stencil(BASIS), NV = MPMC_NV, NC = MPMC_NC, AX = MPMC_PW4_AXIS;
   const size_t qd = (size_t)q * DIM;
-  mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, 1, g, p->x + qd, BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  const double *W = &t->w[0][0][l], *DW = &t->dw[0][0][l]; /* node k, axis a: [AX a + 4 k] */
   const double m = p->m[q];
   const double V = p->vol0[q] * p->J[q];
   const double vf = sim->fbar == MPMC_FBAR_PAPER || sim->fbar == MPMC_FBAR_TOTAL ? V : 0.0;
@@ -281,7 +280,7 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
      * (in 2D the factors themselves, and the rows' sums those of the row-by-row form) */
     mpmc_vd MFz[MPMC_NV], S1z[MPMC_NV], S0z[MPMC_NV];
     if (DIM == 3) {
-      const double wz = pw.w[kz][2], dz = pw.dw[kz][2];
+      const double wz = W[2 * AX + 4 * kz], dz = DW[2 * AX + 4 * kz];
       for (int k = 0; k < NC; ++k) MFz[k] = wz * MF[k];
       for (int k = NC; k < NV; ++k) {
         MFz[k] = wz * MF[k] + dz * S2[k];
@@ -292,16 +291,16 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
       for (int k = 0; k < NV; ++k) MFz[k] = MF[k], S1z[k] = S1[k], S0z[k] = S0[k];
     }
     for (int j = 0; j < S; ++j) {
-      const double wy = pw.w[j][1], dy = pw.dw[j][1];
+      const double wy = W[AX + 4 * j], dy = DW[AX + 4 * j];
       mpmc_vd c[MPMC_NV], e[MPMC_NV];
       for (int k = 0; k < NC; ++k) c[k] = wy * MFz[k];
       for (int k = NC; k < NV; ++k) {
         c[k] = wy * MFz[k] + dy * S1z[k];
         e[k] = wy * S0z[k];
       }
-      double *restrict r = rec + (pw.node0 + sy * (size_t)j + sz * (size_t)kz) * R;
+      double *restrict r = rec + ((size_t)t->node0[l] + sy * (size_t)j + sz * (size_t)kz) * R;
       for (int i = 0; i < S; ++i) {
-        const double wx = pw.w[i][0], dx = pw.dw[i][0];
+        const double wx = W[4 * i], dx = DW[4 * i];
         double *ri = r + i * R;
         for (int k = 0; k < NC; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k];
         for (int k = NC; k < NV; ++k) MPMC_V(ri + MPMC_VW * k) += wx * c[k] + dx * e[k];
@@ -346,15 +345,17 @@ static double *private_grids(mpmc_sim sim, int nt) {
       for (int t = 0; t < nc; ++t) {                                                        \
         const int k1 = mpmc_chunk_start(sim->p.n, t + 1, nc);                               \
         double *rec = t ? priv + per * (size_t)(t - 1) : node;                              \
-        for (int k = mpmc_chunk_start(sim->p.n, t, nc); k < k1; ++k)                        \
-          p2g_point(sim, D, B, rec, order[k]);                                              \
+        MPMC_BATCHES4(0, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order,                     \
+                      mpmc_chunk_start(sim->p.n, t, nc), k1, q, l, w4,                      \
+                      p2g_point(sim, D, B, rec, q, &w4, l));                                \
       }                                                                                     \
       return;                                                                               \
     }                                                                                       \
     for (int colour = 0; colour < 2; ++colour) {                                            \
       _Pragma("omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)")         \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                       \
-        for (int k = start[sl]; k < start[sl + 1]; ++k) p2g_point(sim, D, B, node, order[k]); \
+        MPMC_BATCHES4(0, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order, start[sl],           \
+                      start[sl + 1], q, l, w4, p2g_point(sim, D, B, node, q, &w4, l));      \
     }                                                                                       \
   }
 MPMC_KERNELS(P2G_KERNEL)
