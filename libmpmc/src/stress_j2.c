@@ -214,15 +214,23 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         const int q0 = 4 * blk;
         int act[4], nact = 0;
         v4 F[9], b[6];
-        if (d == 3 && q0 + 3 < n && p->mat[q0] == id && p->mat[q0 + 1] == id &&
-            p->mat[q0 + 2] == id && p->mat[q0 + 3] == id) {
+        if (q0 + 3 < n && p->mat[q0] == id && p->mat[q0 + 1] == id && p->mat[q0 + 2] == id &&
+            p->mat[q0 + 3] == id) {
           /* four points of this material: whole vectors (lane by lane through memory, the
-           * vectors' loads would wait on four scalar stores each) */
-          const double *f = p->dF + (size_t)q0 * 9, *be = p->be + (size_t)q0 * 6;
+           * vectors' loads would wait on four scalar stores each; in 2D that stall was the
+           * update's largest cost); in 2D dF's 2x2 in the plane, the rest of the identity */
+          const double *f = p->dF + (size_t)q0 * d * d, *be = p->be + (size_t)q0 * 6;
           const v4 sc = gather ? (v4){scale[q0 - c0], scale[q0 - c0 + 1], scale[q0 - c0 + 2],
                                       scale[q0 - c0 + 3]}
                                : (v4){1.0, 1.0, 1.0, 1.0};
-          for (int k = 0; k < 9; ++k) F[k] = (v4){f[k], f[9 + k], f[18 + k], f[27 + k]} * sc;
+          if (d == 3)
+            for (int k = 0; k < 9; ++k) F[k] = (v4){f[k], f[9 + k], f[18 + k], f[27 + k]} * sc;
+          else
+            for (int k = 0; k < 9; ++k) {
+              const int i = k / 3, j = k % 3, m = 2 * i + j;
+              F[k] = i < 2 && j < 2 ? (v4){f[m], f[4 + m], f[8 + m], f[12 + m]} * sc
+                                    : (v4){i == j, i == j, i == j, i == j};
+            }
           for (int k = 0; k < 6; ++k) b[k] = (v4){be[k], be[6 + k], be[12 + k], be[18 + k]};
           for (int l = 0; l < 4; ++l) act[l] = 1;
           nact = 4;
