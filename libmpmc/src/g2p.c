@@ -217,10 +217,10 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int t = 0; t < nc; ++t) {                                                            \
       double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                     \
       const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                                  \
-      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order,                          \
-                    mpmc_chunk_start(sim->p.n, t, nc), k1_, q, l, w4,                         \
-                    if (!g2p_point(sim, D, B, FBV, dt, c, f_, q, &w4, l, &v2m) && q < first_bad) \
-                      first_bad = q);                                                         \
+      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,         \
+                    order, mpmc_chunk_start(sim->p.n, t, nc), k1_, q, l, w4,                  \
+                    if (!g2p_point(sim, D, B, FBV, dt, c, f_, q, &w4, l, &v2m) &&             \
+                        q < first_bad) first_bad = q);                                        \
     }                                                                                         \
   } while (0)
 #define G2P_SLABS(D, B, FBV)                                                                  \
@@ -228,8 +228,8 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int colour = 0; colour < 2; ++colour) {                                              \
       _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
       for (int sl = colour; sl < sim->nslab; sl += 2)                                         \
-        MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order, start[sl],             \
-                      start[sl + 1], q, l, w4,                                                \
+        MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,       \
+                      order, start[sl], start[sl + 1], q, l, w4,                              \
                       if (!g2p_point(sim, D, B, FBV, dt, c, fb0, q, &w4, l, &v2m) &&          \
                           q < first_bad) first_bad = q);                                      \
     }                                                                                         \
@@ -241,9 +241,9 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     const int nc = sim->p.n > MPMC_OMP_MIN ? omp_get_max_threads() : 1; /* chunks */         \
     _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) reduction(max : v2m) num_threads(nc)") \
     for (int t = 0; t < nc; ++t)                                                              \
-      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, (const int *)NULL,              \
-                    mpmc_chunk_start(sim->p.n, t, nc), mpmc_chunk_start(sim->p.n, t + 1, nc), \
-                    q, l, w4,                                                                 \
+      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,         \
+                    (const int *)NULL, mpmc_chunk_start(sim->p.n, t, nc),                     \
+                    mpmc_chunk_start(sim->p.n, t + 1, nc), q, l, w4,                          \
                     if (!g2p_point(sim, D, B, 0, dt, c, NULL, q, &w4, l, &v2m) &&             \
                         q < first_bad) first_bad = q);                                        \
     *bad = first_bad == INT_MAX ? -1 : first_bad;                                             \
