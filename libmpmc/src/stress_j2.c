@@ -25,6 +25,7 @@
 #include "return_map.h"
 
 typedef double v4 __attribute__((vector_size(4 * sizeof(double))));
+typedef double v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
 #define J2_CHUNK 64 /* blocks of four points handed to a thread at a time */
 
 /* c = a b for symmetric a, b (Voigt) that commute, as mpmc_sym3_mul */
@@ -280,11 +281,25 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
          * on together (plastic4, pl), the others and any plastic4 hands back one by one */
         int todo[4] = {0, 0, 0, 0}, pl[4] = {0, 0, 0, 0}, npl = 0;
         v4 k0v, qtrv;
+        /* the four strengths kappa(eps_p), mpmc_j2_kappa's operations lane by lane: the exps
+         * in one vector, none when no point of the four has yielded */
+        const double *epb = p->eps_p + q0;
+        const v4 epv = nact == 4 ? (v4)*(const v4u *)epb
+                                 : (v4){act[0] ? epb[0] : 0.0, act[1] ? epb[1] : 0.0,
+                                        act[2] ? epb[2] : 0.0, act[3] ? epb[3] : 0.0};
+        const v4 xk = epv * par.eta, one = {1.0, 1.0, 1.0, 1.0};
+        const mpmc_rm_v4l unyielded = xk == 0.0;
+        v4 ek = one;
+        if (!(unyielded[0] & unyielded[1] & unyielded[2] & unyielded[3]))
+          mpmc_rm_expneg4(&xk, &ek);
+        const v4 k0all = par.kappa_r + (par.kappa_p - par.kappa_r) *
+                                           (v4)((unyielded & (mpmc_rm_v4l)one) |
+                                                (~unyielded & (mpmc_rm_v4l)ek));
         for (int l = 0; l < 4; ++l) {
           k0v[l] = qtrv[l] = 1.0; /* finite dummies for plastic4's unused lanes */
           if (!act[l]) continue;
           const int q = q0 + l;
-          const double k0 = mpmc_j2_kappa(&par, p->eps_p[q]);
+          const double k0 = k0all[l];
           const double qtr = sqrt(q2[l]) * G2;
           double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
           if (!fail[l] && isfinite(qtr) && detb[l] > 0.0 && qtr <= k0) {
