@@ -1,5 +1,6 @@
 /* Local solvers of the Hencky-J2 return map (return_map.c) on 12,000 random trial states
- * over a wide range of materials: newton, kinsol and auto agree on dgamma to 1e-10 relative,
+ * over a wide range of materials: newton, kinsol and auto agree on dgamma to 1e-10 relative
+ * or, where steep softening flattens the residual, as far as their tolerance fixes the root,
  * the returned state satisfies the consistency condition q = kappa(eps_p) to 1e-10 kappa,
  * and auto hands exactly the non-monotone cases to KINSOL; kappa's exp agrees with libm's. */
 #include <setjmp.h>
@@ -101,13 +102,21 @@ static void test_agreement(void **state) {
                  k, solvers[s], vm(tau[s]), kap, cons, pr, info[s].q_trial, info[s].residual,
                  mpmc_rm_tolerance(&t.m, t.ep), t.m.eta, t.m.G);
     }
+    /* the solvers agree on dgamma to 1e-10 relative, or as far as their tolerance on the
+       residual g(dgamma) = q_trial - 3G dgamma - kappa(eps_p + dgamma) fixes the root:
+       2 tol / |g'|, g' = -3G + eta (kappa - kappa_r), which steep softening brings near 0
+       (e.g. eta 1407, q/kappa 1.00016: 3.8e-10 relative apart, both within tolerance) */
+    const double kap1 = mpmc_j2_kappa(&t.m, t.ep + info[0].dgamma);
+    const double gslope = fabs(-3 * t.m.G + t.m.eta * (kap1 - t.m.kappa_r));
+    const double loose = 2 * mpmc_rm_tolerance(&t.m, t.ep) / gslope / info[0].dgamma;
     for (int s = 1; s < 3; ++s) {
       const double rel = fabs(info[s].dgamma - info[0].dgamma) / info[0].dgamma;
-      if (rel > worst_rel) worst_rel = rel;
-      if (rel > 1e-10)
+      const double excess = rel / (1e-10 + loose);
+      if (excess > worst_rel) worst_rel = excess;
+      if (excess > 1)
         fail_msg("state %d: dgamma newton %.17g, solver %d %.17g: relative difference %.3g "
-                 "(expected <= 1e-10); eta %g, q/kappa %g",
-                 k, info[0].dgamma, solvers[s], info[s].dgamma, rel, t.m.eta,
+                 "(expected <= 1e-10 + 2 tol / |g'| / dgamma = %.3g); eta %g, q/kappa %g",
+                 k, info[0].dgamma, solvers[s], info[s].dgamma, rel, 1e-10 + loose, t.m.eta,
                  info[0].q_trial / info[0].kappa);
     }
     /* auto falls back exactly when plain Newton cannot be trusted; in particular whenever
