@@ -32,15 +32,13 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
   return basis == MPMC_BASIS_LINEAR ? 2 : basis == MPMC_BASIS_BSPLINE3 ? 4 : 3;
 }
 
-/* The uGIMP weights of one point along all axes at once: lane a of each vector is axis a
- * (x, y, z, and an unused fourth lane), the same arithmetic on every lane, so one evaluation
- * in vectors of four doubles (one AVX2 register, two SSE2 ones) serves the three axes (for
- * the B-splines and the linear basis the scalar form per axis was the faster).
- * s = (x_p - origin)/h and l = half-length / h per lane (the lanes may also be four points
- * along one axis: fbar.c's gather).  Writes the first stencil
+/* The uGIMP weights of four points along one axis at once, the points in the lanes (the same
+ * arithmetic on every lane: transfer.h's mpmc_point_weights4; mpmc_basis_1d puts one point in
+ * every lane), in vectors of four doubles (one AVX2 register, two SSE2 ones).
+ * s = (x_p - origin)/h and l = half-length / h per lane.  Writes the first stencil
  * node per lane into base, and w[k], dw[k] (d/dx_p, per metre) of the k-th node of each
  * axis's stencil, k < MPMC_MAX_STENCIL (0 for the fourth); dw may be a constant NULL (the
- * weights alone).  w and dw are 32-byte aligned tables (mpmc_pw's), stored into directly.
+ * weights alone).  w and dw are 32-byte aligned tables (mpmc_pw4's), stored into directly.
  *
  * uGIMP (0 < l <= 1/2): the hat N(x) = max(0, 1 - |x|) averaged over the point,
  * w = (1/2l) int_{x-l}^{x+l} N, with y the point's offset from the middle node of its three

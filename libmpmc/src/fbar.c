@@ -47,20 +47,19 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   const mpmc_particles *p = &sim->p;
   const int S = mpmc_stencil(BASIS);
   double *restrict rec = g->node, *restrict fj = g->fbj;
-  mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, 0, g, p->x + (size_t)q * DIM,
-                     BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  mpmc_pw4 t; /* lane 0 */
+  mpmc_point_weights1(DIM, BASIS, 0, g, p->x, p->lp, q, &t);
   const mpmc_v2d vv = scatter_values(sim, DIM, q);
   /* in the products' order of P2G (V: w_x (w_y (w_z V))) and G2P (V j: ((w_x V j) w_z) w_y) */
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
   for (int k = 0; k < (DIM == 3 ? S : 1); ++k)
     for (int j = 0; j < S; ++j) {
-      const size_t row = pw.node0 + sy * (size_t)j + sz * (size_t)k;
-      const double wz = DIM == 3 ? pw.w[k][2] : 1.0, wyzv = pw.w[j][1] * (wz * vv[0]);
+      const size_t row = (size_t)t.node0[0] + sy * (size_t)j + sz * (size_t)k;
+      const double wz = DIM == 3 ? t.w[2][k][0] : 1.0, wyzv = t.w[1][j][0] * (wz * vv[0]);
       for (int i = 0; i < S; ++i) {
-        const double wxj = pw.w[i][0] * vv[1];
-        rec[(row + i) * MPMC_NREC + MPMC_VSLOT] += pw.w[i][0] * wyzv;
-        fj[row + i] += (DIM == 3 ? wxj * wz : wxj) * pw.w[j][1];
+        const double wxj = t.w[0][i][0] * vv[1];
+        rec[(row + i) * MPMC_NREC + MPMC_VSLOT] += t.w[0][i][0] * wyzv;
+        fj[row + i] += (DIM == 3 ? wxj * wz : wxj) * t.w[1][j][0];
       }
     }
 }
@@ -155,12 +154,11 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double inv = 1.0 / p->Jbar[q];
-  mpmc_pw pw;
-  mpmc_point_weights(DIM, BASIS, 0, g, xs + (size_t)q * DIM,
-                     BASIS == MPMC_BASIS_UGIMP ? p->lp[q] : 0.0, &pw);
+  mpmc_pw4 t; /* lane 0 */
+  mpmc_point_weights1(DIM, BASIS, 0, g, xs, p->lp, q, &t);
   mpmc_b4d acc;
-  gather_rows(g, DIM, BASIS, pw.node0, &pw.w[0][1], &pw.w[0][2], 4, &acc);
-  return projection_scale(p, DIM, q, gather_dot(BASIS, &pw.w[0][0], 4, &acc), inv);
+  gather_rows(g, DIM, BASIS, (size_t)t.node0[0], &t.w[1][0][0], &t.w[2][0][0], 4, &acc);
+  return projection_scale(p, DIM, q, gather_dot(BASIS, &t.w[0][0][0], 4, &acc), inv);
 }
 
 /* gather_scale for the four points q .. q + 3 of t into scale[0..3], each lane with the
@@ -263,7 +261,7 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
         if (!one && mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id) \
           continue;                                                                          \
         const int idx[4] = {q, q + 1, q + 2, q + 3};                                         \
-        mpmc_pw4 t; /* the same bits as mpmc_point_weights per point */                      \
+        mpmc_pw4 t; /* the same bits as mpmc_point_weights1 per point */                     \
         mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t);                    \
         if (one || (mat[q] == id && mat[q + 1] == id && mat[q + 2] == id && mat[q + 3] == id)) \
           gather_scale4(sim, D, B, &t, q, scale + (q - q0));                                 \

@@ -10,45 +10,6 @@
 /* GCC cannot see that mpmc_basis_1d fills exactly the stencil that the loops read. */
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 
-typedef struct {
-  /* 1D weights and gradients (per metre), [stencil node][axis]: for uGIMP each row is one
-   * 4-wide vector of mpmc_ugimp_axes, stored in place (a copy through the stack took 80
-   * instructions a point) */
-  double w[MPMC_MAX_STENCIL][4] __attribute__((aligned(32)));
-  double dw[MPMC_MAX_STENCIL][4] __attribute__((aligned(32)));
-  size_t node0; /* linear index of the stencil's first node */
-} mpmc_pw;
-
-/* uGIMP: all axes in one evaluation (basis.h, mpmc_ugimp_axes); the polynomial bases axis by
- * axis (their scalar form was the faster: B-spline2 + F-bar 6.00 against 5.40 M/s).  GRAD = 0:
- * the weights alone (F-bar's scatter and gather), pw->dw left unset. */
-MPMC_ALWAYS_INLINE void mpmc_point_weights(const int DIM, const int BASIS, const int GRAD,
-                                           const mpmc_grid *g, const double *x, double lp,
-                                           mpmc_pw *pw) {
-  int base[3] = {0, 0, 0};
-  if (BASIS == MPMC_BASIS_UGIMP) {
-    const mpmc_b4d xv = {x[0], x[1], DIM == 3 ? x[2] : 0.0, 0.0};
-    const mpmc_b4d o = {g->origin[0], g->origin[1], DIM == 3 ? g->origin[2] : 0.0, 0.0};
-    const mpmc_b4d s = (xv - o) * g->inv_h;
-    mpmc_b4i b;
-    const double l = lp * g->inv_h;
-    const mpmc_b4d lv = {l, l, l, l};
-    mpmc_ugimp_axes(&s, &lv, g->inv_h, &b, (mpmc_b4da *)pw->w,
-                    GRAD ? (mpmc_b4da *)pw->dw : NULL);
-    for (int a = 0; a < DIM; ++a) base[a] = b[a];
-  } else {
-    for (int a = 0; a < DIM; ++a) {
-      double w[MPMC_MAX_STENCIL], dw[MPMC_MAX_STENCIL];
-      mpmc_basis_1d(BASIS, (x[a] - g->origin[a]) * g->inv_h, 0.0, g->inv_h, &base[a], w, dw);
-      for (int k = 0; k < mpmc_stencil(BASIS); ++k) {
-        pw->w[k][a] = w[k];
-        if (GRAD) pw->dw[k][a] = dw[k];
-      }
-    }
-  }
-  pw->node0 = (size_t)base[0] + (size_t)g->n[0] * ((size_t)base[1] + (size_t)g->n[1] * (size_t)base[2]);
-}
-
 /* The 1D weights and gradients of four points, lanes the points: w[a][k][l] of point l's
  * k-th stencil node along axis a (so a point's weights lie MPMC_PW4_AXIS doubles apart
  * between axes and 4 apart between nodes), node0 each point's first stencil node. */
@@ -60,8 +21,7 @@ typedef struct {
 #define MPMC_PW4_AXIS (MPMC_MAX_STENCIL * 4)
 
 /* The weights of points idx[0..3] at x (GRAD = 0: w alone): per axis one evaluation for the
- * four, the same operations per lane as mpmc_point_weights for one point (the same bits; a
- * quarter to a third of its instructions).  A batch of fewer points repeats one of them. */
+ * four, the same operations per lane as mpmc_point_weights1 for one point (the same bits).  A batch of fewer points repeats one of them. */
 MPMC_ALWAYS_INLINE void mpmc_point_weights4(const int DIM, const int BASIS, const int GRAD,
                                             const mpmc_grid *g, const double *x,
                                             const double *lp, const int *idx, mpmc_pw4 *t) {
@@ -87,11 +47,12 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights4(const int DIM, const int BASIS, cons
   memcpy(t->node0, &ni, sizeof ni);
 }
 
-/* Lane 0 of t: the weights of point q alone, axis by axis in scalars (mpmc_basis_1d: the
- * same bits as a lane of mpmc_point_weights4). */
-MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, const mpmc_grid *g,
-                                            const double *x, const double *lp, int q,
-                                            mpmc_pw4 *t) {
+/* Lane 0 of t: the weights of point q alone (GRAD = 0: w alone), axis by axis in scalars
+ * (mpmc_basis_1d: the same bits as a lane of mpmc_point_weights4).  For G2P's linear basis
+ * (MPMC_BATCHES4) and F-bar's single points (fbar.c). */
+MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, const int GRAD,
+                                            const mpmc_grid *g, const double *x,
+                                            const double *lp, int q, mpmc_pw4 *t) {
   size_t node0 = 0, stride = 1;
   for (int a = 0; a < DIM; ++a) {
     int b;
@@ -100,7 +61,7 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, cons
                   BASIS == MPMC_BASIS_UGIMP ? lp[q] * g->inv_h : 0.0, g->inv_h, &b, w, dw);
     for (int k = 0; k < mpmc_stencil(BASIS); ++k) {
       t->w[a][k][0] = w[k];
-      t->dw[a][k][0] = dw[k];
+      if (GRAD) t->dw[a][k][0] = dw[k];
     }
     node0 += stride * (size_t)b;
     stride *= (size_t)g->n[a];
@@ -118,7 +79,7 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, cons
     for (int kb_ = (k0); kb_ < (k1); ++kb_) {                                               \
       const int q = (order) ? (order)[kb_] : kb_, l = 0;                                    \
       mpmc_pw4 t;                                                                           \
-      mpmc_point_weights1(DIM, BASIS, g, x, lp, q, &t);                                     \
+      mpmc_point_weights1(DIM, BASIS, GRAD, g, x, lp, q, &t);                               \
       body;                                                                                 \
     }                                                                                       \
   } else                                                                                    \
