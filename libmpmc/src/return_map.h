@@ -45,13 +45,6 @@ typedef struct mpmc_rm_ws_s mpmc_rm_ws;
 int mpmc_rm_ws_create(mpmc_rm_ws **ws);
 void mpmc_rm_ws_destroy(mpmc_rm_ws **ws);
 
-/* kappa(e) and the scalar solve.  The unknown is q_new = q_trial - 3G dgamma in
- * [kappa_r, kappa(eps_p)] (return_map.c says why).  solver: MPMC_SOLVER_*.  Returns 0,
- * MPMC_ERR_SOLVER (no convergence or KINSOL failure: info->kinsol_flag says which),
- * MPMC_ERR_NUMERIC (non-finite input), MPMC_ERR_ARG (q_trial <= kappa: elastic) or
- * MPMC_ERR_MEMORY (KINSOL could not be created).  ws may be NULL for MPMC_SOLVER_NEWTON.
- * On success *dgamma >= 0, *q_new (may be NULL) > 0 and
- * |q_new - kappa(eps_p + dgamma)| <= mpmc_rm_tolerance(). */
 typedef double mpmc_rm_v4 __attribute__((vector_size(4 * sizeof(double))));
 typedef long long mpmc_rm_v4l __attribute__((vector_size(4 * sizeof(long long))));
 
@@ -59,8 +52,7 @@ typedef long long mpmc_rm_v4l __attribute__((vector_size(4 * sizeof(long long)))
  * arguments: at most 1.0 ulp); 0 beyond x = 708 (libm's value there is below 3.3e-308),
  * NaN for NaN.  exp(-x) = 2^n exp(r), n = round(-x / ln 2) by adding 1.5 2^52, r = -x - n ln 2
  * in two parts (n ln2_hi exact), exp(r) by its Taylor polynomial to r^13 (|r| <= 0.35: the
- * tail below 5e-18).  A vector for the J2 blocks' four strengths (stress_j2.c), one lane for
- * a point alone (mpmc_j2_kappa): the same operations, so the same bits.  Vectors through
+ * tail below 5e-18).  For the softening strengths (mpmc_j2_kappa4).  Vectors through
  * pointers (by value they would change the baseline build's ABI). */
 static inline void mpmc_rm_expneg4(const mpmc_rm_v4 *xp, mpmc_rm_v4 *ep) {
   const mpmc_rm_v4 x = *xp, y = -x;
@@ -87,14 +79,32 @@ static inline void mpmc_rm_expneg4(const mpmc_rm_v4 *xp, mpmc_rm_v4 *ep) {
   *ep = (mpmc_rm_v4)((in & (mpmc_rm_v4l)e) | (~in & ~beyond & (mpmc_rm_v4l)x));
 }
 
+/* kappa(eps_p) of four points, k[l] = kappa_r + (kappa_p - kappa_r) exp(-eta eps[l]): exp(-0)
+ * = 1 exactly, and no exp when none of the four has yielded (most of a slope). */
+static inline void mpmc_j2_kappa4(const mpmc_j2_param *m, const mpmc_rm_v4 *eps,
+                                  mpmc_rm_v4 *k) {
+  const mpmc_rm_v4 x = *eps * m->eta, one = {1.0, 1.0, 1.0, 1.0};
+  const mpmc_rm_v4l unyielded = x == 0.0;
+  mpmc_rm_v4 e = one;
+  if (!(unyielded[0] & unyielded[1] & unyielded[2] & unyielded[3])) mpmc_rm_expneg4(&x, &e);
+  *k = m->kappa_r +
+       (m->kappa_p - m->kappa_r) * (mpmc_rm_v4)((unyielded & (mpmc_rm_v4l)one) |
+                                                (~unyielded & (mpmc_rm_v4l)e));
+}
+
+/* kappa(e) and the scalar solve.  The unknown is q_new = q_trial - 3G dgamma in
+ * [kappa_r, kappa(eps_p)] (return_map.c says why).  solver: MPMC_SOLVER_*.  Returns 0,
+ * MPMC_ERR_SOLVER (no convergence or KINSOL failure: info->kinsol_flag says which),
+ * MPMC_ERR_NUMERIC (non-finite input), MPMC_ERR_ARG (q_trial <= kappa: elastic) or
+ * MPMC_ERR_MEMORY (KINSOL could not be created).  ws may be NULL for MPMC_SOLVER_NEWTON.
+ * On success *dgamma >= 0, *q_new (may be NULL) > 0 and
+ * |q_new - kappa(eps_p + dgamma)| <= mpmc_rm_tolerance().  kappa of one point: lane 0 of
+ * mpmc_j2_kappa4 (the J2 blocks' bits). */
 static inline double mpmc_j2_kappa(const mpmc_j2_param *m, double eps_p) {
-  /* exp(-0) = 1 exactly: points that never yielded (most of a slope) skip the exp */
-  const double x = m->eta * eps_p;
-  if (x == 0.0) return m->kappa_r + (m->kappa_p - m->kappa_r) * 1.0;
-  const mpmc_rm_v4 xv = {x, x, x, x};
-  mpmc_rm_v4 e;
-  mpmc_rm_expneg4(&xv, &e);
-  return m->kappa_r + (m->kappa_p - m->kappa_r) * e[0];
+  const mpmc_rm_v4 ev = {eps_p, eps_p, eps_p, eps_p};
+  mpmc_rm_v4 k;
+  mpmc_j2_kappa4(m, &ev, &k);
+  return k[0];
 }
 double mpmc_rm_tolerance(const mpmc_j2_param *m, double eps_p);
 /* The pieces of the auto solver's Newton iteration (return_map.c, solve_newton) that

@@ -281,20 +281,13 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
          * on together (plastic4, pl), the others and any plastic4 hands back one by one */
         int todo[4] = {0, 0, 0, 0}, pl[4] = {0, 0, 0, 0}, npl = 0;
         v4 k0v, qtrv;
-        /* the four strengths kappa(eps_p), mpmc_j2_kappa's operations lane by lane: the exps
-         * in one vector, none when no point of the four has yielded */
+        /* the four strengths kappa(eps_p) in one vector (mpmc_j2_kappa's bits) */
         const double *epb = p->eps_p + q0;
         const v4 epv = nact == 4 ? (v4)*(const v4u *)epb
                                  : (v4){act[0] ? epb[0] : 0.0, act[1] ? epb[1] : 0.0,
                                         act[2] ? epb[2] : 0.0, act[3] ? epb[3] : 0.0};
-        const v4 xk = epv * par.eta, one = {1.0, 1.0, 1.0, 1.0};
-        const mpmc_rm_v4l unyielded = xk == 0.0;
-        v4 ek = one;
-        if (!(unyielded[0] & unyielded[1] & unyielded[2] & unyielded[3]))
-          mpmc_rm_expneg4(&xk, &ek);
-        const v4 k0all = par.kappa_r + (par.kappa_p - par.kappa_r) *
-                                           (v4)((unyielded & (mpmc_rm_v4l)one) |
-                                                (~unyielded & (mpmc_rm_v4l)ek));
+        v4 k0all;
+        mpmc_j2_kappa4(&par, &epv, &k0all);
         for (int l = 0; l < 4; ++l) {
           k0v[l] = qtrv[l] = 1.0; /* finite dummies for plastic4's unused lanes */
           if (!act[l]) continue;
