@@ -163,11 +163,11 @@ static void test_forced_blowup(void **state) {
  * the points' own J drift in the surge (0.7-1.3 by t = 1 s), the stable form projects them,
  * and the run-up at the far wall blows up at t = 1.02 s; the monitor's message names the
  * form and the way out, Algorithm 1, with which the same scene runs past that time. */
-/* checkpoint_interval: no checkpoint on the way however slow the machine (under valgrind
- * the run outlasts the default 300 wall seconds), so the last good state is the start's */
 static const char *flow_fmt =
     "dim: 2\n"
     "plots: false\n"
+    /* no checkpoint on the way however slow the machine (under valgrind the run outlasts the
+     * default 300 wall seconds), so the last good state is the start's */
     "checkpoint_interval: 1.0e6\n"
     "grid: {lo: [0, 0], hi: [6, 12], cell_size: 0.5}\n"
     "basis: ugimp\n"
