@@ -23,10 +23,42 @@
 
 #include "linalg.h"
 #include "return_map.h"
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 typedef double v4 __attribute__((vector_size(4 * sizeof(double))));
 typedef double v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
+typedef double v2u __attribute__((vector_size(2 * sizeof(double)), aligned(8), may_alias));
+typedef long long l4 __attribute__((vector_size(4 * sizeof(long long))));
 #define J2_CHUNK 64 /* blocks of four points handed to a thread at a time */
+
+/* sqrt per lane (through pointers: vectors by value would change the baseline build's ABI) */
+static inline void sqrt4(const v4 *x, v4 *r) {
+#if defined(__AVX__)
+  *r = (v4)_mm256_sqrt_pd((__m256d)*x);
+#else
+  for (int l = 0; l < 4; ++l) (*r)[l] = sqrt((*x)[l]);
+#endif
+}
+
+/* The six components of four points, v[k][l], stored as the points' rows of six at dst
+ * (dst + 6 l: point l's), by two 4 x 4 transposes' worth of shuffles instead of 24 lane
+ * extractions */
+static inline void store_rows6(const v4 *v, double *dst) {
+  const l4 ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
+  const v4 a0 = __builtin_shuffle(v[0], v[1], ev), a1 = __builtin_shuffle(v[0], v[1], od),
+           a2 = __builtin_shuffle(v[2], v[3], ev), a3 = __builtin_shuffle(v[2], v[3], od),
+           t0 = __builtin_shuffle(v[4], v[5], ev), t1 = __builtin_shuffle(v[4], v[5], od);
+  *(v4u *)dst = __builtin_shuffle(a0, a2, lo);
+  *(v2u *)(dst + 4) = (v2u){t0[0], t0[1]};
+  *(v4u *)(dst + 6) = __builtin_shuffle(a1, a3, lo);
+  *(v2u *)(dst + 10) = (v2u){t1[0], t1[1]};
+  *(v4u *)(dst + 12) = __builtin_shuffle(a0, a2, hi);
+  *(v2u *)(dst + 16) = (v2u){t0[2], t0[3]};
+  *(v4u *)(dst + 18) = __builtin_shuffle(a1, a3, hi);
+  *(v2u *)(dst + 22) = (v2u){t1[2], t1[3]};
+}
 
 /* c = a b for symmetric a, b (Voigt) that commute, as mpmc_sym3_mul */
 static inline void sym_mul4(const v4 *a, const v4 *b, v4 *c) {
@@ -286,47 +318,61 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         const v4 epv = nact == 4 ? (v4)*(const v4u *)epb
                                  : (v4){act[0] ? epb[0] : 0.0, act[1] ? epb[1] : 0.0,
                                         act[2] ? epb[2] : 0.0, act[3] ? epb[3] : 0.0};
-        v4 k0all;
+        v4 k0all, qtr;
         mpmc_j2_kappa4(&par, &epv, &k0all);
+        sqrt4(&q2, &qtr);
+        qtr *= G2;
+        int el[4], ndone = 0;
         for (int l = 0; l < 4; ++l) {
           k0v[l] = qtrv[l] = 1.0; /* finite dummies for plastic4's unused lanes */
-          if (!act[l]) continue;
-          const int q = q0 + l;
-          const double k0 = k0all[l];
-          const double qtr = sqrt(q2[l]) * G2;
-          double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
-          if (!fail[l] && isfinite(qtr) && detb[l] > 0.0 && qtr <= k0) {
-            /* elastic: b_e = trial b */
-            const double inv_J = 1.0 / sqrt(detb[l]);
-            for (int k = 0; k < 6; ++k) be[k] = bt[k][l];
-            for (int k = 0; k < 6; ++k) sg[k] = (G2 * e[k][l] + (k < 3 ? K * tr[l] : 0.0)) * inv_J;
-            if (!mpmc_stress_finite(sg) && q < first_nf) first_nf = q;
-            continue;
-          }
-          k0v[l] = k0, qtrv[l] = qtr;
+          const int ok = act[l] && !fail[l] && isfinite(qtr[l]) && detb[l] > 0.0;
+          el[l] = ok && qtr[l] <= k0all[l]; /* elastic: b_e = trial b */
+          ndone += el[l];
+          if (!act[l] || el[l]) continue;
+          k0v[l] = k0all[l], qtrv[l] = qtr[l];
           todo[l] = 1;
-          pl[l] = solver == MPMC_SOLVER_AUTO && !fail[l] && isfinite(qtr) && detb[l] > 0.0;
+          pl[l] = solver == MPMC_SOLVER_AUTO && ok;
           npl += pl[l];
         }
+        /* b_e and sigma = tau / J, J = sqrt(det b), of the lanes done here in vectors:
+         * tau = 2G e + K tr 1 elastic (el), 2G es + K tr 1 as mpmc_j2_plastic's (series_tau)
+         * from plastic4 (pl); the elastic lanes' shear terms plus +0 as the scalar form adds
+         * it (-0, a no-op, in the others) */
+        const l4 mel = {-(long long)el[0], -(long long)el[1], -(long long)el[2], -(long long)el[3]};
+#define SEL_(m, a, b) ((v4)(((m) & (l4)(a)) | (~(m) & (l4)(b))))
+        v4 dg = {0.0, 0.0, 0.0, 0.0}, bo[6], xs[6];
+        for (int k = 0; k < 6; ++k) bo[k] = bt[k], xs[k] = e[k];
         if (npl) {
-          v4 dg, bn[6], es[6];
+          v4 bn[6], es[6];
+          for (int k = 0; k < 6; ++k) bn[k] = es[k] = dg; /* (lanes it hands back) */
           plastic4(&par, bt, e, &qtrv, &k0v, pl, &dg, bn, es);
-          for (int l = 0; l < 4; ++l) {
-            if (!pl[l]) continue; /* not plastic4's, or handed back */
-            const int q = q0 + l;
-            double *sg = p->stress + (size_t)q * 6, *be = p->be + (size_t)q * 6;
-            for (int k = 0; k < 6; ++k) be[k] = bn[k][l];
-            p->eps_p[q] += dg[l];
-            /* tau as mpmc_j2_plastic's (series_tau), sigma = tau / J, J = sqrt(det b) */
-            const double inv_J = 1.0 / sqrt(detb[l]);
-            for (int k = 0; k < 6; ++k) {
-              double t = G2 * es[k][l];
-              if (k < 3) t += K * tr[l];
-              sg[k] = t * inv_J;
+          npl = pl[0] + pl[1] + pl[2] + pl[3]; /* those it did not hand back */
+          ndone += npl;
+          for (int k = 0; k < 6; ++k) bo[k] = SEL_(mel, bt[k], bn[k]), xs[k] = SEL_(mel, e[k], es[k]);
+        }
+        if (ndone) {
+          const v4 zs = (v4)(~mel & (l4)(v4){-0.0, -0.0, -0.0, -0.0});
+          v4 inv_J, so[6];
+          sqrt4(&detb, &inv_J);
+          inv_J = 1.0 / inv_J;
+          for (int k = 0; k < 6; ++k) so[k] = (k < 3 ? G2 * xs[k] + K * tr : G2 * xs[k] + zs) * inv_J;
+          const v4 sum = so[0] + so[1] + so[2] + so[3] + so[4] + so[5]; /* mpmc_stress_finite */
+          const l4 fin = (sum - sum) == 0.0;
+          if (ndone == 4) { /* a whole block: transposed stores */
+            store_rows6(bo, p->be + (size_t)q0 * 6);
+            store_rows6(so, p->stress + (size_t)q0 * 6);
+            if (npl) *(v4u *)(p->eps_p + q0) = SEL_(mel, epv, epv + dg);
+          } else
+            for (int l = 0; l < 4; ++l) {
+              if (!el[l] && !pl[l]) continue;
+              const size_t q6 = (size_t)(q0 + l) * 6;
+              for (int k = 0; k < 6; ++k) p->be[q6 + k] = bo[k][l], p->stress[q6 + k] = so[k][l];
+              if (pl[l]) p->eps_p[q0 + l] += dg[l];
             }
-            if (!mpmc_stress_finite(sg) && q < first_nf) first_nf = q;
-            ++nret;
-          }
+#undef SEL_
+          for (int l = 0; l < 4; ++l)
+            if ((el[l] || pl[l]) && !fin[l] && q0 + l < first_nf) first_nf = q0 + l;
+          nret += npl;
         }
         for (int l = 0; l < 4; ++l) {
           if (!todo[l] || pl[l]) continue;
