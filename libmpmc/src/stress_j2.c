@@ -42,6 +42,24 @@ static inline void sqrt4(const v4 *x, v4 *r) {
 #endif
 }
 
+/* lanes of a where mask m is set, else of b; |a| per lane; the mask's lanes as bits */
+#define SEL4(m, a, b) ((v4)(((m) & (l4)(a)) | (~(m) & (l4)(b))))
+#define ABS4(a) ((v4)((l4)(a) & ~(l4)(v4){-0.0, -0.0, -0.0, -0.0}))
+static inline int mask_bits(const l4 *m) {
+#if defined(__AVX__)
+  return _mm256_movemask_pd((__m256d)*m);
+#else
+  return (int)(((*m)[0] & 1) | ((*m)[1] & 2) | ((*m)[2] & 4) | ((*m)[3] & 8));
+#endif
+}
+/* the largest lane of r among those of mask m (0 for none; r's lanes are >= 0 or NaN) */
+static inline double max_lane(const v4 *r, const l4 *m) {
+  const v4 zero = {0.0, 0.0, 0.0, 0.0}, v = SEL4(*m, *r, zero);
+  double x = 0.0;
+  for (int l = 0; l < 4; ++l) x = v[l] > x ? v[l] : x;
+  return x;
+}
+
 /* The six components of four points, v[k][l], stored as the points' rows of six at dst
  * (dst + 6 l: point l's), by two 4 x 4 transposes' worth of shuffles instead of 24 lane
  * extractions */
@@ -94,16 +112,13 @@ static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) 
   for (int k = 0; k < 6; ++k) z[k] *= inv_det;
   v4 r2;
   norm2_4(z, &r2);
+  /* fail: |Z|^2 beyond the table or not finite; the degree: that of the largest other lane */
+  const l4 am = {-(long long)act[0], -(long long)act[1], -(long long)act[2], -(long long)act[3]};
+  const l4 ok = am & (r2 <= rho2_max[10]);
+  for (int l = 0; l < 4; ++l) fail[l] = act[l] && !ok[l];
   int n = 1;
-  for (int l = 0; l < 4; ++l) {
-    fail[l] = 0;
-    if (!act[l]) continue;
-    if (!(r2[l] <= rho2_max[10])) {
-      fail[l] = 1;
-      continue;
-    }
-    while (r2[l] > rho2_max[n]) ++n;
-  }
+  const double rmax = max_lane(&r2, &ok);
+  while (rmax > rho2_max[n]) ++n;
   if (n == 1) {
     for (int k = 0; k < 6; ++k) eps[k] = z[k];
     return;
@@ -134,63 +149,52 @@ static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, c
   const double kr = m->kappa_r, c = m->eta / (3.0 * m->G);
   const v4 a = k0 - kr;
   v4 lo = k0 * 0.0 + kr, hi = k0, y, rprev = k0 * 0.0 + INFINITY, tol;
-  int run[4], nrun = 0;
   for (int l = 0; l < 4; ++l) {
     tol[l] = mpmc_rm_tol_k(m, k0[l]);
     if (hi[l] < lo[l]) hi[l] = lo[l];
-    run[l] = pl[l];
-    nrun += run[l];
   }
+  /* the lanes' branches as masks: P plastic4's lanes (pl), R those still iterating */
+  l4 P = {-(long long)pl[0], -(long long)pl[1], -(long long)pl[2], -(long long)pl[3]}, R = P;
   y = hi;
-  for (int it = 0; it < MPMC_RM_MAX_ITERS && nrun; ++it) {
+  for (int it = 0; it < MPMC_RM_MAX_ITERS && mask_bits(&R); ++it) {
     const v4 x = c * (qtr - y);
     v4 ex = MPMC_RM_EXP_NEG_POLY(x);
-    for (int l = 0; l < 4; ++l)
-      if (run[l] && !(fabs(x[l]) <= MPMC_RM_EXP_SMALL)) ex[l] = exp(-x[l]);
+    const l4 big = R & ~(ABS4(x) <= MPMC_RM_EXP_SMALL);
+    for (int bits = mask_bits(&big), l = 0; bits; bits >>= 1, ++l)
+      if (bits & 1) ex[l] = exp(-x[l]);
     const v4 ee = a * ex;
     const v4 dr = 1.0 - c * ee;
     const v4 r = y - (kr + ee);
     const v4 yn = y - r / dr;
-    for (int l = 0; l < 4; ++l) {
-      if (!run[l]) continue;
-      if (fabs(r[l]) <= tol[l]) { /* converged at an evaluated iterate */
-        run[l] = 0, --nrun;
-        continue;
-      }
-      if (r[l] < 0)
-        lo[l] = y[l];
-      else
-        hi[l] = y[l];
-      double ynl = yn[l];
-      const double slack = 8.0 * DBL_EPSILON * hi[l];
-      if (ynl > hi[l] && ynl <= hi[l] + slack) ynl = hi[l];
-      if (ynl < lo[l] && ynl >= lo[l] - slack) ynl = lo[l];
-      if (dr[l] <= 0.0 || (it >= 3 && fabs(r[l]) > 0.5 * fabs(rprev[l])) ||
-          !(ynl >= lo[l] && ynl <= hi[l]) || fabs(ynl - y[l]) <= 2.0 * DBL_EPSILON * fabs(ynl)) {
-        pl[l] = run[l] = 0, --nrun; /* stiff, or a round-off stop: the scalar path */
-        continue;
-      }
-      rprev[l] = r[l];
-      y[l] = ynl;
-    }
+    R &= ~(ABS4(r) <= tol); /* converged at an evaluated iterate */
+    const l4 neg = r < 0.0;
+    lo = SEL4(R & neg, y, lo);
+    hi = SEL4(R & ~neg, y, hi);
+    const v4 slack = 8.0 * DBL_EPSILON * hi;
+    v4 ynl = yn;
+    ynl = SEL4((ynl > hi) & (ynl <= hi + slack), hi, ynl);
+    ynl = SEL4((ynl < lo) & (ynl >= lo - slack), lo, ynl);
+    l4 stiff = (dr <= 0.0) | ~((ynl >= lo) & (ynl <= hi)) |
+               (ABS4(ynl - y) <= 2.0 * DBL_EPSILON * ABS4(ynl));
+    if (it >= 3) stiff |= ABS4(r) > 0.5 * ABS4(rprev);
+    P &= ~(R & stiff); /* stiff, or a round-off stop: the scalar path */
+    R &= ~stiff;
+    rprev = SEL4(R, r, rprev);
+    y = SEL4(R, ynl, y);
   }
-  int n = 1, any = 0;
+  P &= ~R; /* the iteration limit: the scalar path */
+  int n = 1;
   v4 en[6], r2;
   *dg = (qtr - y) / (3.0 * m->G);
   const v4 f = y / qtr, s2 = 2.0 * (f - 1.0);
   for (int k = 0; k < 6; ++k) en[k] = s2 * e[k];
   norm2_4(en, &r2);
-  for (int l = 0; l < 4; ++l) {
-    if (run[l]) pl[l] = 0; /* the iteration limit: the scalar path */
-    if (!pl[l]) continue;
-    if (!((*dg)[l] >= 0.0) || !isfinite((*dg)[l]) || !(y[l] > 0.0) ||
-        !(r2[l] <= mpmc_exp_rho2_max[16])) {
-      pl[l] = 0;
-      continue;
-    }
-    while (r2[l] > mpmc_exp_rho2_max[n]) ++n;
-    any = 1;
-  }
+  /* the solve's checks; the series' degree: that of the largest lane */
+  P &= (*dg >= 0.0) & ((*dg - *dg) == 0.0) & (y > 0.0) & (r2 <= mpmc_exp_rho2_max[16]);
+  const int any = mask_bits(&P) != 0;
+  for (int l = 0; l < 4; ++l) pl[l] = P[l] != 0;
+  const double rmax = max_lane(&r2, &P);
+  while (rmax > mpmc_exp_rho2_max[n]) ++n;
   if (!any) return;
   /* exp(en) as mpmc_sym3_exp_series, then b_e = b exp(en) */
   const double *cf = mpmc_exp_c;
@@ -339,7 +343,6 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
          * from plastic4 (pl); the elastic lanes' shear terms plus +0 as the scalar form adds
          * it (-0, a no-op, in the others) */
         const l4 mel = {-(long long)el[0], -(long long)el[1], -(long long)el[2], -(long long)el[3]};
-#define SEL_(m, a, b) ((v4)(((m) & (l4)(a)) | (~(m) & (l4)(b))))
         v4 dg = {0.0, 0.0, 0.0, 0.0}, bo[6], xs[6];
         for (int k = 0; k < 6; ++k) bo[k] = bt[k], xs[k] = e[k];
         if (npl) {
@@ -348,7 +351,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           plastic4(&par, bt, e, &qtrv, &k0v, pl, &dg, bn, es);
           npl = pl[0] + pl[1] + pl[2] + pl[3]; /* those it did not hand back */
           ndone += npl;
-          for (int k = 0; k < 6; ++k) bo[k] = SEL_(mel, bt[k], bn[k]), xs[k] = SEL_(mel, e[k], es[k]);
+          for (int k = 0; k < 6; ++k) bo[k] = SEL4(mel, bt[k], bn[k]), xs[k] = SEL4(mel, e[k], es[k]);
         }
         if (ndone) {
           const v4 zs = (v4)(~mel & (l4)(v4){-0.0, -0.0, -0.0, -0.0});
@@ -361,7 +364,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           if (ndone == 4) { /* a whole block: transposed stores */
             store_rows6(bo, p->be + (size_t)q0 * 6);
             store_rows6(so, p->stress + (size_t)q0 * 6);
-            if (npl) *(v4u *)(p->eps_p + q0) = SEL_(mel, epv, epv + dg);
+            if (npl) *(v4u *)(p->eps_p + q0) = SEL4(mel, epv, epv + dg);
           } else
             for (int l = 0; l < 4; ++l) {
               if (!el[l] && !pl[l]) continue;
@@ -369,7 +372,6 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
               for (int k = 0; k < 6; ++k) p->be[q6 + k] = bo[k][l], p->stress[q6 + k] = so[k][l];
               if (pl[l]) p->eps_p[q0 + l] += dg[l];
             }
-#undef SEL_
           for (int l = 0; l < 4; ++l)
             if ((el[l] || pl[l]) && !fin[l] && q0 + l < first_nf) first_nf = q0 + l;
           nret += npl;
