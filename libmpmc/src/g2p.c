@@ -5,11 +5,6 @@
  * the paper and total forms only of V^n j: P2G scattered V^n, p2g.c). */
 #include <limits.h>
 #include <math.h>
-#ifdef _OPENMP
-#include <omp.h>
-#else
-#define omp_get_max_threads() 1
-#endif
 
 #include "transfer.h"
 #if defined(__AVX2__)
@@ -238,7 +233,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   static void g2p_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, int *bad, double *vm) { \
     int first_bad = INT_MAX;                                                                  \
     double v2m = 0.0;                                                                         \
-    const int nc = sim->p.n > MPMC_OMP_MIN ? omp_get_max_threads() : 1; /* chunks */         \
+    const int nc = sim->p.n > MPMC_OMP_MIN ? mpmc_max_threads() : 1; /* chunks */            \
     _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) reduction(max : v2m) num_threads(nc)") \
     for (int t = 0; t < nc; ++t)                                                              \
       MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,         \

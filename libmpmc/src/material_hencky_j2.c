@@ -11,10 +11,6 @@
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "linalg.h"
 #include "return_map.h"
 
@@ -163,10 +159,7 @@ static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) 
   mpmc_particles *p = &sim->p;
   const int d = sim->dim, solver = sim->solver;
   const mpmc_j2_param par = {mat->K, mat->G, mat->kappa_p, mat->kappa_r, mat->eta};
-  int nthreads = 1;
-#ifdef _OPENMP
-  nthreads = omp_get_max_threads();
-#endif
+  const int nthreads = mpmc_max_threads();
   mpmc_rm_ws **ws;
   MPMC_CALL(mpmc_rm_sim_workspaces(sim, nthreads, &ws));
   int64_t nret = 0, nfb = 0;

@@ -8,10 +8,21 @@
 #include <stdio.h>
 
 #include "mpmc.h"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /* Parallel loops run on one thread below this many items: forking and joining the team
  * costs more than it saves for small scenes, and far more on a loaded machine. */
 #define MPMC_OMP_MIN 4096
+/* The threads the next parallel region gets: 1 in a build without OpenMP. */
+static inline int mpmc_max_threads(void) {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
 
 /* ---- context and errors (context.c, error.c) ---------------------------------- */
 #define MPMC_MSG_LEN 4096 /* room for a monitor report plus two output paths (workflows) */

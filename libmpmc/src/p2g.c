@@ -5,9 +5,6 @@
 #include <limits.h>
 #include <math.h>
 #include <stdlib.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "transfer.h"
 
@@ -106,11 +103,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     sim->order = o;
     sim->cap_order = n;
   }
-#ifdef _OPENMP
-  const int nt = omp_get_max_threads();
-#else
-  const int nt = 1;
-#endif
+  const int nt = mpmc_max_threads();
   const int nc = n > MPMC_OMP_MIN ? nt : 1; /* chunks */
   int nmax = 1;
   for (int a = 0; a < d; ++a) nmax = g->n[a] > nmax ? g->n[a] : nmax;
@@ -364,11 +357,7 @@ MPMC_KERNELS(P2G_KERNEL)
  * last step's box and built this step's slabs (mpmc_slabs_build). */
 int MPMC_ISA(mpmc_p2g)(mpmc_sim sim, double dt) {
   (void)dt;
-#ifdef _OPENMP
-  const int nt = omp_get_max_threads();
-#else
-  const int nt = 1;
-#endif
+  const int nt = mpmc_max_threads();
   double *priv = private_grids(sim, nt);
   sim->grid.nprivate = priv ? nt : 0;
   MPMC_KERNEL_CALL(p2g_, sim, sim, priv, nt);
