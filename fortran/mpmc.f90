@@ -129,7 +129,7 @@ module mpmc
   public :: mpmc_output_write, mpmc_output_destroy, mpmc_free
   ! ---- public procedures: Fortran wrappers (strings, zero-copy arrays) -------------------
   public :: mpmc_error_string, mpmc_context_last_error, mpmc_context_get_last_error
-  public :: mpmc_phase_name
+  public :: mpmc_phase_name, mpmc_kernels_name
   public :: mpmc_sim_get_field, mpmc_sim_restore_field, mpmc_sim_get_material_ids, &
     mpmc_sim_get_particle_ids, mpmc_sim_get_user_state
   public :: mpmc_sim_add_particle_set, mpmc_sim_get_particle_set, mpmc_sim_find_particle_set
@@ -159,6 +159,11 @@ module mpmc
     function mpmc_phase_name_c(phase) bind(C, name='mpmc_phase_name') result(s)
       import :: c_int, c_ptr
       integer(c_int), value :: phase
+      type(c_ptr) :: s
+    end function
+    function mpmc_kernels_name_c(kernels) bind(C, name='mpmc_kernels_name') result(s)
+      import :: c_int, c_ptr
+      integer(c_int), value :: kernels
       type(c_ptr) :: s
     end function
     function mpmc_context_create(ctx) bind(C, name='mpmc_context_create') result(ierr)
@@ -857,6 +862,14 @@ contains
     character(len=:), allocatable :: s
     s = f_string(mpmc_phase_name_c(phase))
   end function mpmc_phase_name
+
+  !> The name of a kernel set (MPMC_KERNELS_*), as the environment variable MPMC_KERNELS and
+  !> summary.json spell it.
+  function mpmc_kernels_name(kernels) result(s)
+    integer(c_int), intent(in) :: kernels
+    character(len=:), allocatable :: s
+    s = f_string(mpmc_kernels_name_c(kernels))
+  end function mpmc_kernels_name
 
   !> Copy the last error message of ctx into msg (allocated to its length).
   function mpmc_context_get_last_error(ctx, msg) result(ierr)

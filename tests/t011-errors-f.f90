@@ -62,6 +62,10 @@ program t011_errors_f
   call check(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AUTO) == MPMC_SUCCESS, 'set_kernels(AUTO)')
   call check(mpmc_sim_get_kernels(sim, id) == MPMC_SUCCESS .and. (id == MPMC_KERNELS_BASELINE &
     .or. id == MPMC_KERNELS_FMA), 'get_kernels after AUTO is a concrete set')
+  call expect_str('mpmc_kernels_name(MPMC_KERNELS_FMA)', 'fma', mpmc_kernels_name(MPMC_KERNELS_FMA))
+  call expect_str('mpmc_kernels_name(MPMC_KERNELS_BASELINE)', 'baseline', &
+    mpmc_kernels_name(MPMC_KERNELS_BASELINE))
+  call expect_str('mpmc_kernels_name(7)', 'unknown kernel set', mpmc_kernels_name(7_c_int))
   ! clearing forgets the message
   call check(mpmc_context_clear_error(ctx) == MPMC_SUCCESS, 'mpmc_context_clear_error')
   call expect_str('message after clear', '', mpmc_context_last_error(ctx))

@@ -173,6 +173,13 @@ static void set_get(void **state) {
   assert_int_equal(k, mpmc_kernels_avx2_available() ? MPMC_KERNELS_FMA : MPMC_KERNELS_BASELINE);
   assert_int_equal(mpmc_sim_set_kernels(sim, 4), MPMC_ERR_ARG);
   assert_non_null(strstr(mpmc_context_last_error(ctx), "kernels = 4"));
+  /* the names MPMC_KERNELS and summary.json use */
+  assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_AUTO), "auto");
+  assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_BASELINE), "baseline");
+  assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_AVX2), "avx2");
+  assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_FMA), "fma");
+  assert_string_equal(mpmc_kernels_name(4), "unknown kernel set");
+  assert_string_equal(mpmc_kernels_name(-1), "unknown kernel set");
   assert_int_equal(mpmc_sim_get_kernels(sim, NULL), MPMC_ERR_ARG);
   if (!mpmc_kernels_avx2_available()) {
     assert_int_equal(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AVX2), MPMC_ERR_ARG);

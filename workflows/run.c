@@ -199,11 +199,11 @@ static int build(wf_run *w) {
   return 0;
 }
 
-/* the kernel set's name as MPMC_KERNELS and summary.json spell it; with detail, what it is */
-static const char *kernels_name(int k, int detail) {
-  if (k == MPMC_KERNELS_FMA) return detail ? "fma (x86-64-v3, fused multiply-adds)" : "fma";
-  if (k == MPMC_KERNELS_AVX2) return detail ? "avx2 (x86-64-v3)" : "avx2";
-  return "baseline";
+/* the kernel set in use and what it is, for the log */
+static const char *kernels_detail(int k) {
+  if (k == MPMC_KERNELS_FMA) return "fma (x86-64-v3, fused multiply-adds)";
+  if (k == MPMC_KERNELS_AVX2) return "avx2 (x86-64-v3)";
+  return mpmc_kernels_name(k);
 }
 
 static void log_plan(const wf_run *w) {
@@ -246,7 +246,7 @@ static void log_plan(const wf_run *w) {
   say(w, "left out: %s", off[0] ? off : "nothing");
   int kern = MPMC_KERNELS_BASELINE;
   if (w->sim) mpmc_sim_get_kernels(w->sim, &kern);
-  say(w, "kernels: %s", kernels_name(kern, 1));
+  say(w, "kernels: %s", kernels_detail(kern));
   for (int i = 0; i < sc->nmat; ++i) {
     const wf_material *m = &sc->mats[i];
     if (m->model == WF_MODEL_HENCKY_J2)
@@ -594,7 +594,7 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
                                            : "false", w->sc.h);
   int kern = MPMC_KERNELS_BASELINE;
   mpmc_sim_get_kernels(w->sim, &kern);
-  fprintf(f, "  \"kernels\": \"%s\",\n", kernels_name(kern, 0));
+  fprintf(f, "  \"kernels\": \"%s\",\n", mpmc_kernels_name(kern));
   int sort_every = 0;
   mpmc_sim_get_sort_interval(w->sim, &sort_every);
   fprintf(f, "  \"sort_interval\": %d,\n", sort_every);

@@ -93,6 +93,9 @@ typedef enum {
                              /* or CPU lacks it                                      */
   MPMC_KERNELS_FMA = 3       /* x86-64-v3 with fused multiply-adds; refused likewise */
 } mpmc_kernels;
+/* The kernel set's name as MPMC_KERNELS and summary.json spell it ("auto", "baseline",
+ * "avx2", "fma"); "unknown kernel set" outside the list. */
+const char *mpmc_kernels_name(int kernels);
 
 /* Particle fields, readable (and writable) in place.  ncomp per particle in brackets. */
 typedef enum {

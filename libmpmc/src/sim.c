@@ -44,21 +44,30 @@ static int use_kernels(mpmc_sim s, int request, const char *what) {
   return MPMC_SUCCESS;
 }
 
+/**
+ * @brief The name of a kernel set (mpmc_kernels) as MPMC_KERNELS and summary.json spell it,
+ *        a static string.
+ */
+const char *mpmc_kernels_name(int kernels) {
+  static const char *const names[] = {"auto", "baseline", "avx2", "fma"};
+  return kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_FMA ? names[kernels]
+                                                                     : "unknown kernel set";
+}
+
 /* The default set, or the one MPMC_KERNELS names (auto, baseline, avx2, fma). */
 static int kernels_from_env(mpmc_sim s) {
-  static const char *const names[] = {"auto", "baseline", "avx2", "fma"};
   const char *e = getenv("MPMC_KERNELS");
   int req = MPMC_KERNELS_AUTO;
   if (e && *e) {
     req = -1;
-    for (int k = 0; k < 4; ++k)
-      if (!strcmp(e, names[k])) req = k;
+    for (int k = MPMC_KERNELS_AUTO; k <= MPMC_KERNELS_FMA; ++k)
+      if (!strcmp(e, mpmc_kernels_name(k))) req = k;
     MPMC_CHECK(req >= 0, s->ctx, MPMC_ERR_ARG,
                "environment variable MPMC_KERNELS = '%.40s' is not one of auto, baseline, avx2, "
                "fma", e);
   }
   char what[64];
-  snprintf(what, sizeof what, "environment variable MPMC_KERNELS = %s", names[req]);
+  snprintf(what, sizeof what, "environment variable MPMC_KERNELS = %s", mpmc_kernels_name(req));
   return use_kernels(s, req, what);
 }
 
