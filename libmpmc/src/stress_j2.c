@@ -60,6 +60,36 @@ static inline double max_lane(const v4 *r, const l4 *m) {
   return x;
 }
 
+/* v[i][l] = r_l[i], i < 4, for four rows r_l of four (a 4 x 4 transpose) */
+static inline void transpose4(const v4 *r, v4 *v) {
+  const l4 ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
+  const v4 a0 = __builtin_shuffle(r[0], r[1], ev), a1 = __builtin_shuffle(r[0], r[1], od),
+           a2 = __builtin_shuffle(r[2], r[3], ev), a3 = __builtin_shuffle(r[2], r[3], od);
+  v[0] = __builtin_shuffle(a0, a2, lo);
+  v[1] = __builtin_shuffle(a1, a3, lo);
+  v[2] = __builtin_shuffle(a0, a2, hi);
+  v[3] = __builtin_shuffle(a1, a3, hi);
+}
+
+/* v[k][l] = src[w l + k], k < 8: the first eight of four points' rows of w >= 8 doubles */
+static inline void load_rows8(const double *src, int w, v4 *v) {
+  v4 r[4];
+  for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + w * l);
+  transpose4(r, v);
+  for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + w * l + 4);
+  transpose4(r, v + 4);
+}
+
+/* v[k][l] = src[6 l + k]: four points' rows of six (store_rows6's inverse) */
+static inline void load_rows6(const double *src, v4 *v) {
+  v4 r[4];
+  for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + 6 * l);
+  transpose4(r, v);
+  const v4 x = {src[4], src[5], src[16], src[17]}, y = {src[10], src[11], src[22], src[23]};
+  v[4] = __builtin_shuffle(x, y, (l4){0, 4, 2, 6});
+  v[5] = __builtin_shuffle(x, y, (l4){1, 5, 3, 7});
+}
+
 /* The six components of four points, v[k][l], stored as the points' rows of six at dst
  * (dst + 6 l: point l's), by two 4 x 4 transposes' worth of shuffles instead of 24 lane
  * extractions */
@@ -260,15 +290,17 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           const v4 sc = gather ? (v4){scale[q0 - c0], scale[q0 - c0 + 1], scale[q0 - c0 + 2],
                                       scale[q0 - c0 + 3]}
                                : (v4){1.0, 1.0, 1.0, 1.0};
-          if (d == 3)
-            for (int k = 0; k < 9; ++k) F[k] = (v4){f[k], f[9 + k], f[18 + k], f[27 + k]} * sc;
-          else
+          if (d == 3) {
+            load_rows8(f, 9, F);
+            F[8] = (v4){f[8], f[17], f[26], f[35]};
+            for (int k = 0; k < 9; ++k) F[k] *= sc;
+          } else
             for (int k = 0; k < 9; ++k) {
               const int i = k / 3, j = k % 3, m = 2 * i + j;
               F[k] = i < 2 && j < 2 ? (v4){f[m], f[4 + m], f[8 + m], f[12 + m]} * sc
                                     : (v4){i == j, i == j, i == j, i == j};
             }
-          for (int k = 0; k < 6; ++k) b[k] = (v4){be[k], be[6 + k], be[12 + k], be[18 + k]};
+          load_rows6(be, b);
           for (int l = 0; l < 4; ++l) act[l] = 1;
           nact = 4;
         } else
