@@ -294,12 +294,15 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
             load_rows8(f, 9, F);
             F[8] = (v4){f[8], f[17], f[26], f[35]};
             for (int k = 0; k < 9; ++k) F[k] *= sc;
-          } else
+          } else { /* dF's 2 x 2 rows of four points, transposed: components xx, xy, yx, yy */
+            v4 r[4], c[4];
+            for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(f + 4 * l);
+            transpose4(r, c);
             for (int k = 0; k < 9; ++k) {
-              const int i = k / 3, j = k % 3, m = 2 * i + j;
-              F[k] = i < 2 && j < 2 ? (v4){f[m], f[4 + m], f[8 + m], f[12 + m]} * sc
-                                    : (v4){i == j, i == j, i == j, i == j};
+              const int i = k / 3, j = k % 3;
+              F[k] = i < 2 && j < 2 ? c[2 * i + j] * sc : (v4){i == j, i == j, i == j, i == j};
             }
+          }
           load_rows6(be, b);
           for (int l = 0; l < 4; ++l) act[l] = 1;
           nact = 4;
