@@ -126,9 +126,9 @@ static inline void norm2_4(const v4 *s, v4 *r) {
 }
 
 /* The block's trial Hencky strain eps = 1/2 ln b by linalg.h's series (same tables and
- * Horner scheme), at the degree the largest active lane needs.  fail[l] = 1 for a lane
+ * Horner scheme), at the degree the largest active lane (mask am) needs.  fail: the lanes
  * whose strain the series cannot take (|Z|^2 above the table, or not finite). */
-static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) {
+static inline void log_series4(const v4 *b, const l4 *am, v4 *eps, l4 *fail) {
   const double *rho2_max = mpmc_atanh_rho2_max, *c = mpmc_atanh_c;
   const v4 a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
   const v4 m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
@@ -143,9 +143,8 @@ static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) 
   v4 r2;
   norm2_4(z, &r2);
   /* fail: |Z|^2 beyond the table or not finite; the degree: that of the largest other lane */
-  const l4 am = {-(long long)act[0], -(long long)act[1], -(long long)act[2], -(long long)act[3]};
-  const l4 ok = am & (r2 <= rho2_max[10]);
-  for (int l = 0; l < 4; ++l) fail[l] = act[l] && !ok[l];
+  const l4 ok = *am & (r2 <= rho2_max[10]);
+  *fail = *am & ~ok;
   int n = 1;
   const double rmax = max_lane(&r2, &ok);
   while (rmax > rho2_max[n]) ++n;
@@ -163,7 +162,7 @@ static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) 
   sym_mul4(z, p, eps);
 }
 
-/* The plastic lanes of a block (pl[l] = 1) returned together, for the auto solver:
+/* The plastic lanes of a block (mask *pl) returned together, for the auto solver:
  * return_map.c's Newton iteration (solve_newton, strict) lane by lane in vectors -- the
  * same operations in the same order, the branches taken per lane, so each lane gets the
  * scalar solve's bits -- then mpmc_j2_plastic's b_e = b exp(2 (f - 1) e), the series at the
@@ -171,9 +170,9 @@ static inline void log_series4(const v4 *b, const int *act, v4 *eps, int *fail) 
  * qtr > k0 = kappa(eps_p).  Outputs for each lane it returns: dg, be, the scaled deviator es.
  * A lane the iteration calls stiff (KINSOL's case), whose result fails the solve's checks or
  * ended on a round-off step (its residual needs libm's exp), or whose correction is beyond
- * the series, gets pl[l] = 0: mpmc_j2_plastic repeats it alone and reports or falls back. */
+ * the series, leaves *pl: mpmc_j2_plastic repeats it alone and reports or falls back. */
 static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, const v4 *qtrp,
-                            const v4 *k0p, int *pl, v4 *dg, v4 *be, v4 *es) {
+                            const v4 *k0p, l4 *pl, v4 *dg, v4 *be, v4 *es) {
   /* (vectors through pointers: by value they would change the baseline build's ABI) */
   const v4 qtr = *qtrp, k0 = *k0p;
   const double kr = m->kappa_r, c = m->eta / (3.0 * m->G);
@@ -184,7 +183,7 @@ static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, c
     if (hi[l] < lo[l]) hi[l] = lo[l];
   }
   /* the lanes' branches as masks: P plastic4's lanes (pl), R those still iterating */
-  l4 P = {-(long long)pl[0], -(long long)pl[1], -(long long)pl[2], -(long long)pl[3]}, R = P;
+  l4 P = *pl, R = P;
   y = hi;
   for (int it = 0; it < MPMC_RM_MAX_ITERS && mask_bits(&R); ++it) {
     const v4 x = c * (qtr - y);
@@ -222,7 +221,7 @@ static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, c
   /* the solve's checks; the series' degree: that of the largest lane */
   P &= (*dg >= 0.0) & ((*dg - *dg) == 0.0) & (y > 0.0) & (r2 <= mpmc_exp_rho2_max[16]);
   const int any = mask_bits(&P) != 0;
-  for (int l = 0; l < 4; ++l) pl[l] = P[l] != 0;
+  *pl = P;
   const double rmax = max_lane(&r2, &P);
   while (rmax > mpmc_exp_rho2_max[n]) ++n;
   if (!any) return;
@@ -337,8 +336,9 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           bt[k] = T[i][0] * F[3 * j] + T[i][1] * F[3 * j + 1] + T[i][2] * F[3 * j + 2];
         }
         v4 eps[6], e[6];
-        int fail[4];
-        log_series4(bt, act, eps, fail);
+        const l4 am = {-(long long)act[0], -(long long)act[1], -(long long)act[2], -(long long)act[3]};
+        l4 fail;
+        log_series4(bt, &am, eps, &fail);
         const v4 tr = eps[0] + eps[1] + eps[2];
         for (int k = 0; k < 6; ++k) e[k] = eps[k];
         for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
@@ -349,9 +349,8 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         const v4 detb = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
                         bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
         /* elastic lanes finish here (the rest: todo); with the auto solver the plastic ones go
-         * on together (plastic4, pl), the others and any plastic4 hands back one by one */
-        int todo[4] = {0, 0, 0, 0}, pl[4] = {0, 0, 0, 0}, npl = 0;
-        v4 k0v, qtrv;
+         * on together (plastic4, pl), the others and any plastic4 hands back one by one; the
+         * lanes' cases as masks */
         /* the four strengths kappa(eps_p) in one vector (mpmc_j2_kappa's bits) */
         const double *epb = p->eps_p + q0;
         const v4 epv = nact == 4 ? (v4)*(const v4u *)epb
@@ -361,30 +360,26 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         mpmc_j2_kappa4(&par, &epv, &k0all);
         sqrt4(&q2, &qtr);
         qtr *= G2;
-        int el[4], ndone = 0;
-        for (int l = 0; l < 4; ++l) {
-          k0v[l] = qtrv[l] = 1.0; /* finite dummies for plastic4's unused lanes */
-          const int ok = act[l] && !fail[l] && isfinite(qtr[l]) && detb[l] > 0.0;
-          el[l] = ok && qtr[l] <= k0all[l]; /* elastic: b_e = trial b */
-          ndone += el[l];
-          if (!act[l] || el[l]) continue;
-          k0v[l] = k0all[l], qtrv[l] = qtr[l];
-          todo[l] = 1;
-          pl[l] = solver == MPMC_SOLVER_AUTO && ok;
-          npl += pl[l];
-        }
+        const v4 one = {1.0, 1.0, 1.0, 1.0};
+        const l4 ok = am & ~fail & ((qtr - qtr) == 0.0) & (detb > 0.0); /* qtr finite */
+        const l4 mel = ok & (qtr <= k0all);  /* elastic: b_e = trial b */
+        const l4 todo = am & ~mel;
+        l4 pl = solver == MPMC_SOLVER_AUTO ? todo & ok : (l4){0, 0, 0, 0};
+        /* finite dummies for plastic4's unused lanes */
+        const v4 k0v = SEL4(todo, k0all, one), qtrv = SEL4(todo, qtr, one);
+        int npl = __builtin_popcount((unsigned)mask_bits(&pl));
+        int ndone = __builtin_popcount((unsigned)mask_bits(&mel));
         /* b_e and sigma = tau / J, J = sqrt(det b), of the lanes done here in vectors:
-         * tau = 2G e + K tr 1 elastic (el), 2G es + K tr 1 as mpmc_j2_plastic's (series_tau)
+         * tau = 2G e + K tr 1 elastic (mel), 2G es + K tr 1 as mpmc_j2_plastic's (series_tau)
          * from plastic4 (pl); the elastic lanes' shear terms plus +0 as the scalar form adds
          * it (-0, a no-op, in the others) */
-        const l4 mel = {-(long long)el[0], -(long long)el[1], -(long long)el[2], -(long long)el[3]};
         v4 dg = {0.0, 0.0, 0.0, 0.0}, bo[6], xs[6];
         for (int k = 0; k < 6; ++k) bo[k] = bt[k], xs[k] = e[k];
         if (npl) {
           v4 bn[6], es[6];
           for (int k = 0; k < 6; ++k) bn[k] = es[k] = dg; /* (lanes it hands back) */
-          plastic4(&par, bt, e, &qtrv, &k0v, pl, &dg, bn, es);
-          npl = pl[0] + pl[1] + pl[2] + pl[3]; /* those it did not hand back */
+          plastic4(&par, bt, e, &qtrv, &k0v, &pl, &dg, bn, es);
+          npl = __builtin_popcount((unsigned)mask_bits(&pl)); /* those it did not hand back */
           ndone += npl;
           for (int k = 0; k < 6; ++k) bo[k] = SEL4(mel, bt[k], bn[k]), xs[k] = SEL4(mel, e[k], es[k]);
         }
@@ -395,24 +390,26 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           inv_J = 1.0 / inv_J;
           for (int k = 0; k < 6; ++k) so[k] = (k < 3 ? G2 * xs[k] + K * tr : G2 * xs[k] + zs) * inv_J;
           const v4 sum = so[0] + so[1] + so[2] + so[3] + so[4] + so[5]; /* mpmc_stress_finite */
-          const l4 fin = (sum - sum) == 0.0;
+          const l4 done = mel | pl, bad = done & ~((sum - sum) == 0.0);
           if (ndone == 4) { /* a whole block: transposed stores */
             store_rows6(bo, p->be + (size_t)q0 * 6);
             store_rows6(so, p->stress + (size_t)q0 * 6);
             if (npl) *(v4u *)(p->eps_p + q0) = SEL4(mel, epv, epv + dg);
           } else
-            for (int l = 0; l < 4; ++l) {
-              if (!el[l] && !pl[l]) continue;
+            for (int bits = mask_bits(&done), l = 0; bits; bits >>= 1, ++l) {
+              if (!(bits & 1)) continue;
               const size_t q6 = (size_t)(q0 + l) * 6;
               for (int k = 0; k < 6; ++k) p->be[q6 + k] = bo[k][l], p->stress[q6 + k] = so[k][l];
               if (pl[l]) p->eps_p[q0 + l] += dg[l];
             }
-          for (int l = 0; l < 4; ++l)
-            if ((el[l] || pl[l]) && !fin[l] && q0 + l < first_nf) first_nf = q0 + l;
+          const int bbits = mask_bits(&bad);
+          if (bbits && q0 + __builtin_ctz((unsigned)bbits) < first_nf)
+            first_nf = q0 + __builtin_ctz((unsigned)bbits);
           nret += npl;
         }
-        for (int l = 0; l < 4; ++l) {
-          if (!todo[l] || pl[l]) continue;
+        const l4 rest = todo & ~pl;
+        for (int bits = mask_bits(&rest), l = 0; bits; bits >>= 1, ++l) {
+          if (!(bits & 1)) continue;
           const int q = q0 + l;
           double *ep = p->eps_p + q;
           const double k0 = k0v[l], qtr = qtrv[l];
