@@ -91,20 +91,16 @@ static inline void load_rows6(const double *src, v4 *v) {
 }
 
 /* The six components of four points, v[k][l], stored as the points' rows of six at dst
- * (dst + 6 l: point l's), by two 4 x 4 transposes' worth of shuffles instead of 24 lane
- * extractions */
+ * (dst + 6 l: point l's), by a transpose and two shuffles instead of 24 lane extractions */
 static inline void store_rows6(const v4 *v, double *dst) {
-  const l4 ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
-  const v4 a0 = __builtin_shuffle(v[0], v[1], ev), a1 = __builtin_shuffle(v[0], v[1], od),
-           a2 = __builtin_shuffle(v[2], v[3], ev), a3 = __builtin_shuffle(v[2], v[3], od),
-           t0 = __builtin_shuffle(v[4], v[5], ev), t1 = __builtin_shuffle(v[4], v[5], od);
-  *(v4u *)dst = __builtin_shuffle(a0, a2, lo);
+  v4 r[4];
+  transpose4(v, r);
+  const v4 t0 = __builtin_shuffle(v[4], v[5], (l4){0, 4, 2, 6}),
+           t1 = __builtin_shuffle(v[4], v[5], (l4){1, 5, 3, 7});
+  for (int l = 0; l < 4; ++l) *(v4u *)(dst + 6 * l) = r[l];
   *(v2u *)(dst + 4) = (v2u){t0[0], t0[1]};
-  *(v4u *)(dst + 6) = __builtin_shuffle(a1, a3, lo);
   *(v2u *)(dst + 10) = (v2u){t1[0], t1[1]};
-  *(v4u *)(dst + 12) = __builtin_shuffle(a0, a2, hi);
   *(v2u *)(dst + 16) = (v2u){t0[2], t0[3]};
-  *(v4u *)(dst + 18) = __builtin_shuffle(a1, a3, hi);
   *(v2u *)(dst + 22) = (v2u){t1[2], t1[3]};
 }
 
