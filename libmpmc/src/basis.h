@@ -58,6 +58,18 @@ typedef int mpmc_b4i __attribute__((vector_size(4 * sizeof(int))));
 /* the same as mpmc_b4d in memory that is also read as doubles (the weight tables) */
 typedef double mpmc_b4da __attribute__((vector_size(4 * sizeof(double)), may_alias));
 
+/* v[i][l] = r[l][i]: four rows of four doubles transposed (the J2 blocks' loads and stores,
+ * stress_j2.c; F-bar's four row sums, fbar.c) */
+MPMC_ALWAYS_INLINE void mpmc_transpose4(const mpmc_b4d *r, mpmc_b4d *v) {
+  const mpmc_b4l ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
+  const mpmc_b4d a0 = __builtin_shuffle(r[0], r[1], ev), a1 = __builtin_shuffle(r[0], r[1], od),
+                 a2 = __builtin_shuffle(r[2], r[3], ev), a3 = __builtin_shuffle(r[2], r[3], od);
+  v[0] = __builtin_shuffle(a0, a2, lo);
+  v[1] = __builtin_shuffle(a1, a3, lo);
+  v[2] = __builtin_shuffle(a0, a2, hi);
+  v[3] = __builtin_shuffle(a1, a3, hi);
+}
+
 /* floor per lane as doubles (|s| < 2^31), its int in *bi: with AVX the rounding
  * instruction, else truncation corrected below zero; the same values (vectors through
  * pointers: by value they would change the baseline build's ABI) */

@@ -173,14 +173,8 @@ MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BAS
     gather_rows(&sim->grid, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l],
                 4, &a[l]);
   /* c[i] = (a[0][i], .., a[3][i]): lanes the points, as t's weights */
-  const mpmc_b4d e0 = __builtin_shuffle(a[0], a[1], (mpmc_b4l){0, 4, 2, 6}),
-                 o0 = __builtin_shuffle(a[0], a[1], (mpmc_b4l){1, 5, 3, 7}),
-                 e1 = __builtin_shuffle(a[2], a[3], (mpmc_b4l){0, 4, 2, 6}),
-                 o1 = __builtin_shuffle(a[2], a[3], (mpmc_b4l){1, 5, 3, 7});
-  const mpmc_b4d c[4] = {__builtin_shuffle(e0, e1, (mpmc_b4l){0, 1, 4, 5}),
-                         __builtin_shuffle(o0, o1, (mpmc_b4l){0, 1, 4, 5}),
-                         __builtin_shuffle(e0, e1, (mpmc_b4l){2, 3, 6, 7}),
-                         __builtin_shuffle(o0, o1, (mpmc_b4l){2, 3, 6, 7})};
+  mpmc_b4d c[4];
+  mpmc_transpose4(a, c);
   const mpmc_b4da *wx = (const mpmc_b4da *)t->w[0];
   mpmc_b4d pi = wx[0] * c[0];
   for (int i = 1; i < mpmc_stencil(BASIS); ++i) pi = MADD4V(wx[i], c[i], pi);

@@ -21,6 +21,7 @@
 #include <omp.h>
 #endif
 
+#include "basis.h"
 #include "linalg.h"
 #include "return_map.h"
 #if defined(__AVX__)
@@ -60,31 +61,20 @@ static inline double max_lane(const v4 *r, const l4 *m) {
   return x;
 }
 
-/* v[i][l] = r_l[i], i < 4, for four rows r_l of four (a 4 x 4 transpose) */
-static inline void transpose4(const v4 *r, v4 *v) {
-  const l4 ev = {0, 4, 2, 6}, od = {1, 5, 3, 7}, lo = {0, 1, 4, 5}, hi = {2, 3, 6, 7};
-  const v4 a0 = __builtin_shuffle(r[0], r[1], ev), a1 = __builtin_shuffle(r[0], r[1], od),
-           a2 = __builtin_shuffle(r[2], r[3], ev), a3 = __builtin_shuffle(r[2], r[3], od);
-  v[0] = __builtin_shuffle(a0, a2, lo);
-  v[1] = __builtin_shuffle(a1, a3, lo);
-  v[2] = __builtin_shuffle(a0, a2, hi);
-  v[3] = __builtin_shuffle(a1, a3, hi);
-}
-
 /* v[k][l] = src[w l + k], k < 8: the first eight of four points' rows of w >= 8 doubles */
 static inline void load_rows8(const double *src, int w, v4 *v) {
   v4 r[4];
   for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + w * l);
-  transpose4(r, v);
+  mpmc_transpose4(r, v);
   for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + w * l + 4);
-  transpose4(r, v + 4);
+  mpmc_transpose4(r, v + 4);
 }
 
 /* v[k][l] = src[6 l + k]: four points' rows of six (store_rows6's inverse) */
 static inline void load_rows6(const double *src, v4 *v) {
   v4 r[4];
   for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + 6 * l);
-  transpose4(r, v);
+  mpmc_transpose4(r, v);
   const v4 x = {src[4], src[5], src[16], src[17]}, y = {src[10], src[11], src[22], src[23]};
   v[4] = __builtin_shuffle(x, y, (l4){0, 4, 2, 6});
   v[5] = __builtin_shuffle(x, y, (l4){1, 5, 3, 7});
@@ -94,7 +84,7 @@ static inline void load_rows6(const double *src, v4 *v) {
  * (dst + 6 l: point l's), by a transpose and two shuffles instead of 24 lane extractions */
 static inline void store_rows6(const v4 *v, double *dst) {
   v4 r[4];
-  transpose4(v, r);
+  mpmc_transpose4(v, r);
   const v4 t0 = __builtin_shuffle(v[4], v[5], (l4){0, 4, 2, 6}),
            t1 = __builtin_shuffle(v[4], v[5], (l4){1, 5, 3, 7});
   for (int l = 0; l < 4; ++l) *(v4u *)(dst + 6 * l) = r[l];
@@ -292,7 +282,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           } else { /* dF's 2 x 2 rows of four points, transposed: components xx, xy, yx, yy */
             v4 r[4], c[4];
             for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(f + 4 * l);
-            transpose4(r, c);
+            mpmc_transpose4(r, c);
             for (int k = 0; k < 9; ++k) {
               const int i = k / 3, j = k % 3;
               F[k] = i < 2 && j < 2 ? c[2 * i + j] * sc : (v4){i == j, i == j, i == j, i == j};
