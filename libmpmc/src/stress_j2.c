@@ -272,9 +272,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
            * vectors' loads would wait on four scalar stores each; in 2D that stall was the
            * update's largest cost); in 2D dF's 2x2 in the plane, the rest of the identity */
           const double *f = p->dF + (size_t)q0 * d * d, *be = p->be + (size_t)q0 * 6;
-          const v4 sc = gather ? (v4){scale[q0 - c0], scale[q0 - c0 + 1], scale[q0 - c0 + 2],
-                                      scale[q0 - c0 + 3]}
-                               : (v4){1.0, 1.0, 1.0, 1.0};
+          const v4 sc = gather ? (v4)*(const v4u *)(scale + (q0 - c0)) : (v4){1.0, 1.0, 1.0, 1.0};
           if (d == 3) {
             load_rows8(f, 9, F);
             F[8] = (v4){f[8], f[17], f[26], f[35]};
@@ -322,7 +320,8 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           bt[k] = T[i][0] * F[3 * j] + T[i][1] * F[3 * j + 1] + T[i][2] * F[3 * j + 2];
         }
         v4 eps[6], e[6];
-        const l4 am = {-(long long)act[0], -(long long)act[1], -(long long)act[2], -(long long)act[3]};
+        const l4 am = {-(long long)act[0], -(long long)act[1], -(long long)act[2],
+                       -(long long)act[3]};
         l4 fail;
         log_series4(bt, &am, eps, &fail);
         const v4 tr = eps[0] + eps[1] + eps[2];
@@ -367,14 +366,16 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           plastic4(&par, bt, e, &qtrv, &k0v, &pl, &dg, bn, es);
           npl = __builtin_popcount((unsigned)mask_bits(&pl)); /* those it did not hand back */
           ndone += npl;
-          for (int k = 0; k < 6; ++k) bo[k] = SEL4(mel, bt[k], bn[k]), xs[k] = SEL4(mel, e[k], es[k]);
+          for (int k = 0; k < 6; ++k)
+            bo[k] = SEL4(mel, bt[k], bn[k]), xs[k] = SEL4(mel, e[k], es[k]);
         }
         if (ndone) {
           const v4 zs = (v4)(~mel & (l4)(v4){-0.0, -0.0, -0.0, -0.0});
           v4 inv_J, so[6];
           sqrt4(&detb, &inv_J);
           inv_J = 1.0 / inv_J;
-          for (int k = 0; k < 6; ++k) so[k] = (k < 3 ? G2 * xs[k] + K * tr : G2 * xs[k] + zs) * inv_J;
+          for (int k = 0; k < 6; ++k)
+            so[k] = (k < 3 ? G2 * xs[k] + K * tr : G2 * xs[k] + zs) * inv_J;
           const v4 sum = so[0] + so[1] + so[2] + so[3] + so[4] + so[5]; /* mpmc_stress_finite */
           const l4 done = mel | pl, bad = done & ~((sum - sum) == 0.0);
           if (ndone == 4) { /* a whole block: transposed stores */

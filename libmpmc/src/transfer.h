@@ -21,7 +21,8 @@ typedef struct {
 #define MPMC_PW4_AXIS (MPMC_MAX_STENCIL * 4)
 
 /* The weights of points idx[0..3] at x (GRAD = 0: w alone): per axis one evaluation for the
- * four, the same operations per lane as mpmc_point_weights1 for one point (the same bits).  A batch of fewer points repeats one of them. */
+ * four, the same operations per lane as mpmc_point_weights1 for one point (the same bits).
+ * A batch of fewer points repeats one of them. */
 MPMC_ALWAYS_INLINE void mpmc_point_weights4(const int DIM, const int BASIS, const int GRAD,
                                             const mpmc_grid *g, const double *x,
                                             const double *lp, const int *idx, mpmc_pw4 *t) {
