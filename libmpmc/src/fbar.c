@@ -307,11 +307,12 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   /* nodal volume average (Algorithm 1 step 3) into fbj, row by row: (V J)_i from fb's pairs
    * (stable form) or fbj itself, V_i from fb or the records */
   const long nrow = mpmc_grid_active_rows(g);
-  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
+  const long box = (long)(g->act_hi[0] - g->act_lo[0]);
   const double *restrict fb = g->fb, *restrict rec = g->node;
-#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+#pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
-    const size_t first = mpmc_grid_active_row(g, r);
+    size_t len;
+    const size_t first = mpmc_grid_active_row(g, r, &len);
     double *fj = g->fbj + first;
     if (stable) {
       const double *f = fb + 2 * first;

@@ -49,16 +49,37 @@ static int alloc_d(mpmc_context ctx, double **a, size_t n) {
   return MPMC_SUCCESS;
 }
 
+/* every row of the box [act_lo, act_hi) active over the box's whole x range */
+static void rows_full(mpmc_grid *g) {
+  if (!g->rowx) return;
+  for (int k = g->act_lo[2]; k < g->act_hi[2]; ++k)
+    for (int j = g->act_lo[1]; j < g->act_hi[1]; ++j) {
+      int *rx = g->rowx + 2 * ((size_t)j + (size_t)g->n[1] * (size_t)k);
+      rx[0] = g->act_lo[0];
+      rx[1] = g->act_hi[0];
+    }
+}
+
 static void set_active_all(mpmc_grid *g) {
   for (int a = 0; a < 3; ++a) {
     g->act_lo[a] = 0;
     g->act_hi[a] = g->n[a];
   }
+  rows_full(g);
 }
 
 int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
   const size_t nn = g->nn;
   MPMC_CALL(alloc_d(ctx, &g->node, nn * MPMC_NREC));
+  if (!g->rowx) {
+    g->rowx = malloc(sizeof(int) * 2 * (size_t)g->n[1] * (size_t)g->n[2]);
+    MPMC_CHECK(g->rowx, ctx, MPMC_ERR_MEMORY, "cannot allocate the ranges of %d grid rows",
+               g->n[1] * g->n[2]);
+    for (size_t r = 0; r < (size_t)g->n[1] * (size_t)g->n[2]; ++r) {
+      g->rowx[2 * r] = 0;
+      g->rowx[2 * r + 1] = g->n[0];
+    }
+  }
   if (with_fbar == MPMC_FBAR_STABLE) MPMC_CALL(alloc_d(ctx, &g->fb, nn * 2));
   if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fbj, nn + 4)); /* the gather reads 4 from a row start */
   if (!g->fixed) {
@@ -82,11 +103,12 @@ void mpmc_grid_clear(mpmc_grid *g, int with_fbar) {
  * half of the step's slab phase on two threads. */
 static void clear_box(mpmc_grid *g, int with_node) {
   const long nrow = mpmc_grid_active_rows(g);
-  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
+  const long box = (long)(g->act_hi[0] - g->act_lo[0]);
   double *node = g->node, *fb = g->fb, *fbj = g->fbj;
-#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+#pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
-    const size_t first = mpmc_grid_active_row(g, r);
+    size_t len;
+    const size_t first = mpmc_grid_active_row(g, r, &len);
     if (with_node)
       memset(node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
     else
@@ -113,6 +135,10 @@ void mpmc_grid_free(mpmc_grid *g) {
   free(g->fixed);
   free(g->ccount);
   free(g->fbpriv);
+  free(g->rowx);
+  free(g->rscratch);
+  g->rowx = g->rscratch = NULL;
+  g->cap_rscratch = 0;
   g->node = g->fb = g->fbj = g->priv = g->fbpriv = NULL;
   g->fixed = NULL;
   g->ccount = NULL;
@@ -138,10 +164,12 @@ void mpmc_grid_add_copies(const mpmc_grid *g, double *dst, double *copies, int w
                           int ncopies) {
   const size_t per = g->nn * (size_t)width;
   const long nrow = mpmc_grid_active_rows(g);
-  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]) * (size_t)width;
-#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+  const long box = (long)(g->act_hi[0] - g->act_lo[0]) * width;
+#pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
-    const size_t first = mpmc_grid_active_row(g, r) * (size_t)width;
+    size_t nodes;
+    const size_t first = mpmc_grid_active_row(g, r, &nodes) * (size_t)width;
+    const size_t len = nodes * (size_t)width;
     double *restrict d = dst + first;
     for (int t = 0; t < ncopies; ++t) {
       double *restrict src = copies + per * (size_t)t + first;

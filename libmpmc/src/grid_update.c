@@ -13,10 +13,11 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   const unsigned short *restrict fx = g->fixed;
   /* only the active box holds mass */
   const long nrow = mpmc_grid_active_rows(g);
-  const size_t len = (size_t)(g->act_hi[0] - g->act_lo[0]);
-#pragma omp parallel for schedule(static) if (nrow * (long)len > MPMC_OMP_MIN)
+  const long box = (long)(g->act_hi[0] - g->act_lo[0]);
+#pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long row = 0; row < nrow; ++row) {
-    const size_t first = mpmc_grid_active_row(g, row);
+    size_t len;
+    const size_t first = mpmc_grid_active_row(g, row, &len);
     for (size_t i = first; i < first + len; ++i) {
       double *restrict r = rec + i * R;
       const double m = r[0];
@@ -45,10 +46,36 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   }
 }
 
+/* Row (j, k)'s x range (grid.rowx) widened to hold [lo, hi); an empty range becomes it. */
+static void widen_range(int *rx, int lo, int hi) {
+  if (hi <= lo) return;
+  if (rx[1] <= rx[0]) {
+    rx[0] = lo;
+    rx[1] = hi;
+    return;
+  }
+  rx[0] = lo < rx[0] ? lo : rx[0];
+  rx[1] = hi > rx[1] ? hi : rx[1];
+}
+
+/* The rows of planes [from, to) along axis a (1 or 2) within the box's other axis: empty. */
+static void rows_empty(mpmc_grid *g, int a, int from, int to) {
+  const int b = a == 1 ? 2 : 1;
+  for (int i = from; i < to; ++i)
+    for (int o = g->act_lo[b]; o < g->act_hi[b]; ++o) {
+      int *rx = g->rowx + 2 * (a == 1 ? (size_t)i + (size_t)g->n[1] * (size_t)o
+                                       : (size_t)o + (size_t)g->n[1] * (size_t)i);
+      rx[0] = rx[1] = g->act_lo[0];
+    }
+}
+
 /* The ghosts in the active box fold into partners across the wall that may lie outside it:
- * grow the box to hold them (nodes outside it are zero, so nothing needs clearing). */
+ * grow the box to hold them (nodes outside it are zero, so nothing needs clearing), and the
+ * partners' row ranges: across an x wall each row's range to the partners of its ghosts,
+ * across a y or z wall the partner row's range to its ghost row's. */
 static void grow_box_for_mirrors(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
+  const size_t n1 = (size_t)g->n[1];
   for (int w = 0; w < sim->nmirror; ++w) {
     const mpmc_mirror *m = &sim->mirrors[w];
     const int a = m->axis;
@@ -56,8 +83,25 @@ static void grow_box_for_mirrors(mpmc_sim sim) {
     for (int k = 1; k <= MPMC_GHOST; ++k) {
       const int ig = m->plane + m->side * k, im = m->plane - m->side * k;
       if (ig < g->act_lo[a] || ig >= g->act_hi[a] || im < 0 || im >= g->n[a]) continue;
+      if (a == 0) {
+        for (int kz = g->act_lo[2]; kz < g->act_hi[2]; ++kz)
+          for (int j = g->act_lo[1]; j < g->act_hi[1]; ++j) {
+            int *rx = g->rowx + 2 * ((size_t)j + n1 * (size_t)kz);
+            if (ig >= rx[0] && ig < rx[1]) widen_range(rx, im, im + 1);
+          }
+      } else {
+        if (im < g->act_lo[a]) rows_empty(g, a, im, g->act_lo[a]);
+        if (im >= g->act_hi[a]) rows_empty(g, a, g->act_hi[a], im + 1);
+      }
       if (im < g->act_lo[a]) g->act_lo[a] = im;
       if (im >= g->act_hi[a]) g->act_hi[a] = im + 1;
+      if (a == 0) continue;
+      const int b = a == 1 ? 2 : 1;
+      for (int o = g->act_lo[b]; o < g->act_hi[b]; ++o) {
+        const size_t rg = a == 1 ? (size_t)ig + n1 * (size_t)o : (size_t)o + n1 * (size_t)ig;
+        const size_t rm = a == 1 ? (size_t)im + n1 * (size_t)o : (size_t)o + n1 * (size_t)im;
+        widen_range(g->rowx + 2 * rm, g->rowx[2 * rg], g->rowx[2 * rg + 1]);
+      }
     }
   }
 }

@@ -126,9 +126,19 @@ typedef struct {
                           beyond the stencil unused                                      */
   unsigned short *fixed; /* [nn] bit a: component a fixed; bit 3+a: v_a >= 0 only; bit 6+a: v_a <= 0 only */
   /* node index box [act_lo, act_hi) per axis outside which node and fb are zero: the points'
-   * stencils of the last P2G (and the mirror partners the grid update folded into); P2G
-   * clears only this box and the grid update visits only it */
+   * stencils of the last P2G (and the mirror partners the grid update folded into); the
+   * step clears only this box and the grid update visits only it, each row over its rowx
+   * range */
   int act_lo[3], act_hi[3];
+  /* [n1 n2][2]: for each node row (j, k) of the active box, the x range [lo, hi) of its
+   * nodes outside which node, fb and fbj are zero, as the box (mpmc_slabs_build: the
+   * stencils of the points in the cell rows around it); a spreading flow leaves most of its
+   * box empty (the landslide's at 4 s of run-out: 44 % of it reached), so the grid's passes
+   * (clearing, the per-thread copies' sum, the grid update, F-bar's average) go row by row
+   * over these ranges alone */
+  int *rowx;
+  int *rscratch; /* p2g.c scratch: per chunk, the x range of the cells of each cell row */
+  size_t cap_rscratch;
   int fb_done;         /* G2P scattered this step's F-bar volumes (fused, race-free)     */
   int fb_gather;       /* the step's F-bar gather is left to the material update (every
                           material's ops->gathers_fbar): it reads x^n from the points' xn */
@@ -158,17 +168,23 @@ void mpmc_grid_add_copies(const mpmc_grid *g, double *dst, double *copies, int w
  * fbj and the records' MPMC_VSLOT */
 void mpmc_grid_clear_fb_active(mpmc_grid *g);
 void mpmc_grid_free(mpmc_grid *g);
-/* The active box as rows of nodes along x: their number, and the first node of row r (each
- * row holds act_hi[0] - act_lo[0] consecutive nodes). */
+/* The active box as rows of nodes along x: their number, and row r's first active node and
+ * the number of active nodes that follow it consecutively (its rowx range, at most the box's
+ * act_hi[0] - act_lo[0]). */
 static inline long mpmc_grid_active_rows(const mpmc_grid *g) {
   const long ny = g->act_hi[1] - g->act_lo[1], nz = g->act_hi[2] - g->act_lo[2];
   return g->act_hi[0] > g->act_lo[0] && ny > 0 && nz > 0 ? ny * nz : 0;
 }
-static inline size_t mpmc_grid_active_row(const mpmc_grid *g, long r) {
+/* the grid row (j, k) index j + n1 k of the active box's row r */
+static inline size_t mpmc_grid_row_index(const mpmc_grid *g, long r) {
   const long ny = g->act_hi[1] - g->act_lo[1];
-  return (size_t)g->act_lo[0] +
-         (size_t)g->n[0] * ((size_t)(g->act_lo[1] + r % ny) +
-                            (size_t)g->n[1] * (size_t)(g->act_lo[2] + r / ny));
+  return (size_t)(g->act_lo[1] + r % ny) + (size_t)g->n[1] * (size_t)(g->act_lo[2] + r / ny);
+}
+static inline size_t mpmc_grid_active_row(const mpmc_grid *g, long r, size_t *len) {
+  const size_t row = mpmc_grid_row_index(g, r);
+  const int lo = g->rowx[2 * row], hi = g->rowx[2 * row + 1];
+  *len = hi > lo ? (size_t)(hi - lo) : 0;
+  return (size_t)lo + (size_t)g->n[0] * row;
 }
 /* nodal mass of node i (after P2G) */
 static inline double mpmc_grid_mass(const mpmc_grid *g, size_t i) {

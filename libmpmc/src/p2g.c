@@ -8,12 +8,19 @@
 
 #include "transfer.h"
 
+/* The x range of cells cx .. cx (one point) or of a run into the cell row's entry e[0..1]. */
+static inline void widen_row(int *restrict e, int lo, int hi) {
+  e[0] = lo < e[0] ? lo : e[0];
+  e[1] = hi > e[1] ? hi : e[1];
+}
+
 /* mpmc_slabs_build's first pass over points q0 .. q1 - 1 (one chunk): their cells' box into box
  * (lo[3], hi[3]), each point's plane along axis ax into plane, the points per plane added to
- * ct; DIM a constant, so that the axes unroll. */
+ * ct, and the x range of the cells holding points per cell row (cy + n1 cz) widened into
+ * rx[2 row ..]; DIM a constant, so that the axes unroll. */
 MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const double *xs, int q0,
                                     int q1, int ax, int *restrict plane, int *restrict ct,
-                                    int *restrict box) {
+                                    int *restrict box, int *restrict rx) {
   int lo[3] = {INT_MAX, INT_MAX, INT_MAX}, hi[3] = {-1, -1, -1};
   double o[3] = {0.0, 0.0, 0.0};
   for (int a = 0; a < DIM; ++a) o[a] = g->origin[a];
@@ -25,6 +32,8 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
   __m128i lov = _mm_set1_epi32(INT_MAX), hiv = _mm_set1_epi32(-1);
 #endif
   int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
+  int crow = -1, rlo = 0, rhi = 0; /* and runs of one cell row, their x range likewise */
+  const int n1 = g->n[1];
   for (int q = q0; q < q1; ++q) {
     const double *x = xs + (size_t)q * DIM;
 #if defined(__AVX2__)
@@ -34,6 +43,8 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
     hiv = _mm_max_epi32(hiv, cv);
     const int pl = _mm_cvtsi128_si32(
         _mm_castps_si128(_mm_permutevar_ps(_mm_castsi128_ps(cv), axv)));
+    const int cx = _mm_cvtsi128_si32(cv), cy = _mm_extract_epi32(cv, 1);
+    const int row = DIM == 3 ? cy + n1 * _mm_extract_epi32(cv, 2) : cy;
 #else
     int c[3] = {0, 0, 0};
     for (int a = 0; a < DIM; ++a) {
@@ -42,7 +53,16 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
       hi[a] = c[a] > hi[a] ? c[a] : hi[a];
     }
     const int pl = ax == 0 ? c[0] : ax == 1 ? c[1] : c[2];
+    const int cx = c[0], row = DIM == 3 ? c[1] + n1 * c[2] : c[1];
 #endif
+    if (row != crow) {
+      if (crow >= 0) widen_row(rx + 2 * crow, rlo, rhi);
+      crow = row;
+      rlo = rhi = cx;
+    } else {
+      rlo = cx < rlo ? cx : rlo;
+      rhi = cx > rhi ? cx : rhi;
+    }
     plane[q] = pl;
     if (pl != cur) {
       if (run) ct[cur] += run;
@@ -52,6 +72,7 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
     ++run;
   }
   if (run) ct[cur] += run;
+  if (crow >= 0) widen_row(rx + 2 * crow, rlo, rhi);
 #if defined(__AVX2__)
   int lv[4], hv[4];
   _mm_storeu_si128((__m128i *)lv, lov);
@@ -65,6 +86,44 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const mpmc_grid *g, const dou
     box[a] = lo[a];
     box[3 + a] = hi[a];
   }
+}
+
+/* The active box's row ranges (grid.rowx) from the chunks' cell-row ranges in rscratch, the
+ * points' cells spanning [clo, chi]: node row (j, k) holds the stencils (nodes c - 1 .. c + 2
+ * along each axis, as the box) of the points in the cell rows j - 2 .. j + 1, k - 2 .. k + 1,
+ * so its range is theirs widened by one node below and two above. */
+static void row_ranges(mpmc_grid *g, int d, int nc, const int *clo, const int *chi) {
+  const int n1 = g->n[1];
+  const size_t nrows = (size_t)n1 * (size_t)g->n[2];
+  int *rx0 = g->rscratch;
+  const int zlo = d == 3 ? clo[2] : 0, zhi = d == 3 ? chi[2] : 0;
+  for (int t = 1; t < nc; ++t) {
+    const int *rx = g->rscratch + 2 * nrows * (size_t)t;
+    for (int cz = zlo; cz <= zhi; ++cz)
+      for (int cy = clo[1]; cy <= chi[1]; ++cy) {
+        const size_t r = (size_t)cy + (size_t)n1 * (size_t)cz;
+        widen_row(rx0 + 2 * r, rx[2 * r], rx[2 * r + 1]);
+      }
+  }
+  for (int k = g->act_lo[2]; k < g->act_hi[2]; ++k)
+    for (int j = g->act_lo[1]; j < g->act_hi[1]; ++j) {
+      int lo = INT_MAX, hi = -1;
+      const int z0 = d == 3 && k - 2 > zlo ? k - 2 : zlo, z1 = d == 3 && k + 1 < zhi ? k + 1 : zhi;
+      const int y0 = j - 2 > clo[1] ? j - 2 : clo[1], y1 = j + 1 < chi[1] ? j + 1 : chi[1];
+      for (int cz = z0; cz <= z1; ++cz)
+        for (int cy = y0; cy <= y1; ++cy) {
+          const int *e = rx0 + 2 * ((size_t)cy + (size_t)n1 * (size_t)cz);
+          lo = e[0] < lo ? e[0] : lo;
+          hi = e[1] > hi ? e[1] : hi;
+        }
+      int *out = g->rowx + 2 * ((size_t)j + (size_t)n1 * (size_t)k);
+      if (hi < 0) { /* no point's stencil reaches this row */
+        out[0] = out[1] = g->act_lo[0];
+      } else {
+        out[0] = lo - 1 > g->act_lo[0] ? lo - 1 : g->act_lo[0];
+        out[1] = hi + 3 < g->act_hi[0] ? hi + 3 : g->act_hi[0];
+      }
+    }
 }
 
 /* Bucket the points into slabs of whole cell planes along one axis (a counting sort of
@@ -117,6 +176,14 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     g->cap_ccount = need;
   }
   int *cnt = g->ccount, *box = cnt + (size_t)nc * nmax;
+  /* per chunk the x range of the cells of each cell row, [nc][n1 n2][2] */
+  const size_t nrows = (size_t)g->n[1] * (size_t)g->n[2], rneed = 2 * nrows * (size_t)nc;
+  if (rneed > g->cap_rscratch) {
+    int *r = realloc(g->rscratch, sizeof(int) * rneed);
+    MPMC_CHECK(r, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the ranges of %zu cell rows", nrows);
+    g->rscratch = r;
+    g->cap_rscratch = rneed;
+  }
   int *plane = (int *)(void *)p->dF;
   int clo[3] = {0, 0, 0}, chi[3] = {0, 0, 0};
   int ax = sim->slab_axis >= 0 && sim->slab_axis < d ? sim->slab_axis : d - 1;
@@ -125,13 +192,17 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
      * inside the ghost layers, so the cell coordinates are positive) and the plane counts */
 #pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
     for (int t = 0; t < nc; ++t) {
-      int *ct = cnt + (size_t)t * nmax;
+      int *ct = cnt + (size_t)t * nmax, *rx = g->rscratch + 2 * nrows * (size_t)t;
       for (int k = 0; k < nmax; ++k) ct[k] = 0;
+      for (size_t r = 0; r < nrows; ++r) {
+        rx[2 * r] = INT_MAX;
+        rx[2 * r + 1] = -1;
+      }
       const int q0 = mpmc_chunk_start(n, t, nc), q1 = mpmc_chunk_start(n, t + 1, nc);
       if (d == 3)
-        count_chunk(3, g, p->x, q0, q1, ax, plane, ct, box + 6 * t);
+        count_chunk(3, g, p->x, q0, q1, ax, plane, ct, box + 6 * t, rx);
       else
-        count_chunk(2, g, p->x, q0, q1, ax, plane, ct, box + 6 * t);
+        count_chunk(2, g, p->x, q0, q1, ax, plane, ct, box + 6 * t, rx);
     }
     for (int a = 0; a < d; ++a) {
       clo[a] = INT_MAX;
@@ -150,6 +221,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     g->act_lo[a] = lo < 0 ? 0 : lo;
     g->act_hi[a] = hi > g->n[a] ? g->n[a] : hi;
   }
+  row_ranges(g, d, nc, clo, chi);
   const int np = chi[ax] - clo[ax] + 1; /* planes */
   const int per = np / (MPMC_SLAB_W * 2 * nt);
   const double share = (double)n / (2 * nt * (per < 1 ? 1 : per));
