@@ -54,12 +54,13 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
   const int S = mpmc_stencil(BASIS), AX = MPMC_PW4_AXIS;
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
   const mpmc_b4d wxv = (mpmc_b4d){W[0], W[4], S > 2 ? W[8] : 0.0, S > 3 ? W[12] : 0.0} * vj;
-  for (int k = 0; k < (DIM == 3 ? S : 1); ++k) {
+  double *f = fb + node0;
+  for (int k = 0; k < (DIM == 3 ? S : 1); ++k, f += sz) {
     const mpmc_b4d wzv = DIM == 3 ? wxv * W[2 * AX + 4 * k] : wxv;
-    double *f = fb + node0 + sz * (size_t)k;
-    for (int j = 0; j < S; ++j) {
+    double *r = f;
+    for (int j = 0; j < S; ++j, r += sy) {
       const mpmc_b4d add = wzv * W[AX + 4 * j];
-      fb_row(S, WIDE, f + sy * (size_t)j, &add);
+      fb_row(S, WIDE, r, &add);
     }
   }
 }
