@@ -49,8 +49,8 @@ static int alloc_d(mpmc_context ctx, double **a, size_t n) {
   return MPMC_SUCCESS;
 }
 
-/* every row of the box [act_lo, act_hi) active over the box's whole x range */
-static void rows_full(mpmc_grid *g) {
+/** Every row of the box [act_lo, act_hi) active over the box's whole x range. */
+void mpmc_grid_rows_full(mpmc_grid *g) {
   if (!g->rowx) return;
   for (int k = g->act_lo[2]; k < g->act_hi[2]; ++k)
     for (int j = g->act_lo[1]; j < g->act_hi[1]; ++j) {
@@ -65,7 +65,7 @@ static void set_active_all(mpmc_grid *g) {
     g->act_lo[a] = 0;
     g->act_hi[a] = g->n[a];
   }
-  rows_full(g);
+  mpmc_grid_rows_full(g);
 }
 
 int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {

@@ -139,6 +139,7 @@ typedef struct {
   int *rowx;
   int *rscratch; /* p2g.c scratch: per chunk, the x range of the cells of each cell row */
   size_t cap_rscratch;
+  int rows_skip; /* slab builds left that take the whole box's rows (p2g.c, row_ranges) */
   int fb_done;         /* G2P scattered this step's F-bar volumes (fused, race-free)     */
   int fb_gather;       /* the step's F-bar gather is left to the material update (every
                           material's ops->gathers_fbar): it reads x^n from the points' xn */
@@ -168,6 +169,8 @@ void mpmc_grid_add_copies(const mpmc_grid *g, double *dst, double *copies, int w
  * fbj and the records' MPMC_VSLOT */
 void mpmc_grid_clear_fb_active(mpmc_grid *g);
 void mpmc_grid_free(mpmc_grid *g);
+/* every row of the active box over the box's whole x range (grid.rowx) */
+void mpmc_grid_rows_full(mpmc_grid *g);
 /* The active box as rows of nodes along x: their number, and row r's first active node and
  * the number of active nodes that follow it consecutively (its rowx range, at most the box's
  * act_hi[0] - act_lo[0]). */
