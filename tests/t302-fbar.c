@@ -288,15 +288,48 @@ static void test_fb_cleared(void **state) {
 }
 
 /* The grid's passes go over each node row's x range alone (grid.rowx, p2g.c's row_ranges, the
- * mirrors' partners added by the grid update): after each step every nonzero grid value (any
+ * mirrors' partners added by the grid update): after a step every nonzero grid value (any
  * record slot, fb, fbj) lies in the active box and in its row's range, and the reset of the
- * last step's ranges (mpmc_grid_clear_active) leaves the whole grid zero.  A wedge (x + y
- * below 4 m in 2D, x + z in 3D, on a 12 m floor) slumping under gravity and sliding along
- * x, with slip walls on x = 0 and (3D) on both y faces and a fixed floor, whose ghost nodes
- * the B-splines and uGIMP mirror; every basis and dimension, the paper's form and the
- * stable one (fb), one and two threads (the latter may scatter into per-thread grids).  The
- * ranges must leave part of the box out (the wedge's upper rows are short), or the test
- * would not show them. */
+ * last step's ranges (mpmc_grid_clear_active) leaves the whole grid zero.  Adds the nodes
+ * the ranges held and those of the box to *ranged and *boxed. */
+static void check_rows(mpmc_sim sim, const char *what, int s, long *ranged, long *boxed) {
+  const mpmc_grid *g = &sim->grid;
+  for (int kz = 0; kz < g->n[2]; ++kz)
+    for (int j = 0; j < g->n[1]; ++j) {
+      const size_t row = (size_t)j + (size_t)g->n[1] * (size_t)kz;
+      const int in_box =
+          j >= g->act_lo[1] && j < g->act_hi[1] && kz >= g->act_lo[2] && kz < g->act_hi[2];
+      const int rlo = g->rowx[2 * row], rhi = g->rowx[2 * row + 1];
+      if (in_box) {
+        *ranged += rhi > rlo ? rhi - rlo : 0;
+        *boxed += g->act_hi[0] - g->act_lo[0];
+        if (rhi > rlo && (rlo < g->act_lo[0] || rhi > g->act_hi[0]))
+          fail_msg("%s step %d: row (%d, %d) range [%d, %d) outside the box [%d, %d)", what, s,
+                   j, kz, rlo, rhi, g->act_lo[0], g->act_hi[0]);
+      }
+      for (int i = 0; i < g->n[0]; ++i) {
+        const size_t nd = (size_t)i + (size_t)g->n[0] * row;
+        int nonzero = g->fbj[nd] != 0.0 || (g->fb && (g->fb[2 * nd] != 0.0 || g->fb[2 * nd + 1] != 0.0));
+        for (int e = 0; e < MPMC_NREC; ++e) nonzero |= g->node[nd * MPMC_NREC + e] != 0.0;
+        if (nonzero && !(in_box && i >= rlo && i < rhi))
+          fail_msg("%s step %d: node (%d, %d, %d) holds values outside its row's range [%d, "
+                   "%d)%s", what, s, i, j, kz, rlo, rhi, in_box ? "" : " and the box");
+      }
+    }
+  mpmc_grid_clear_active(&sim->grid);
+  for (size_t i = 0; i < g->nn; ++i) {
+    int nonzero = g->fbj[i] != 0.0 || (g->fb && (g->fb[2 * i] != 0.0 || g->fb[2 * i + 1] != 0.0));
+    for (int e = 0; e < MPMC_NREC; ++e) nonzero |= g->node[i * MPMC_NREC + e] != 0.0;
+    if (nonzero) fail_msg("%s step %d: node %zu nonzero after the reset", what, s, i);
+  }
+}
+
+/* check_rows on a wedge (x + y below 4 m in 2D, x + z in 3D, on a 12 m floor) slumping under
+ * gravity and sliding along x, with slip walls on x = 0 and (3D) on both y faces and a fixed
+ * floor, whose ghost nodes the B-splines and uGIMP mirror; every basis and dimension, the
+ * paper's form and the stable one (fb), one and two threads (the latter may scatter into
+ * per-thread grids).  The ranges must leave part of the box out (the wedge's upper rows are
+ * short), or the test would not show them. */
 static void test_row_ranges(void **state) {
   (void)state;
   for (int dim = 2; dim <= 3; ++dim)
@@ -338,53 +371,66 @@ static void test_row_ranges(void **state) {
           TCALL(mpmc_sim_prepare(sim));
           double dt;
           TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
-          const mpmc_grid *g = &sim->grid;
+          char what[96];
+          snprintf(what, sizeof what, "wedge, dim %d basis %d form %d threads %d", dim, b, m, th);
           long ranged = 0, boxed = 0;
           for (int s = 0; s < 30; ++s) {
             TCALL(mpmc_sim_step(sim, dt));
-            for (int kz = 0; kz < g->n[2]; ++kz)
-              for (int j = 0; j < g->n[1]; ++j) {
-                const size_t row = (size_t)j + (size_t)g->n[1] * (size_t)kz;
-                const int in_box = j >= g->act_lo[1] && j < g->act_hi[1] && kz >= g->act_lo[2] &&
-                                   kz < g->act_hi[2];
-                const int rlo = g->rowx[2 * row], rhi = g->rowx[2 * row + 1];
-                if (in_box) {
-                  ranged += rhi > rlo ? rhi - rlo : 0;
-                  boxed += g->act_hi[0] - g->act_lo[0];
-                  if (rhi > rlo && (rlo < g->act_lo[0] || rhi > g->act_hi[0]))
-                    fail_msg("dim %d basis %d form %d: row (%d, %d) range [%d, %d) outside the "
-                             "box [%d, %d)", dim, b, m, j, kz, rlo, rhi, g->act_lo[0], g->act_hi[0]);
-                }
-                for (int i = 0; i < g->n[0]; ++i) {
-                  const size_t nd = (size_t)i + (size_t)g->n[0] * row;
-                  int nonzero = g->fbj[nd] != 0.0 || (g->fb && (g->fb[2 * nd] != 0.0 || g->fb[2 * nd + 1] != 0.0));
-                  for (int e = 0; e < MPMC_NREC; ++e) nonzero |= g->node[nd * MPMC_NREC + e] != 0.0;
-                  if (nonzero && !(in_box && i >= rlo && i < rhi))
-                    fail_msg("dim %d basis %d form %d threads %d step %d: node (%d, %d, %d) holds "
-                             "values outside its row's range [%d, %d)%s", dim, b, m, th, s, i, j, kz,
-                             rlo, rhi, in_box ? "" : " and the box");
-                }
-              }
-            mpmc_grid_clear_active(&sim->grid);
-            for (size_t i = 0; i < g->nn; ++i) {
-              int nonzero = g->fbj[i] != 0.0 || (g->fb && (g->fb[2 * i] != 0.0 || g->fb[2 * i + 1] != 0.0));
-              for (int e = 0; e < MPMC_NREC; ++e) nonzero |= g->node[i * MPMC_NREC + e] != 0.0;
-              if (nonzero) fail_msg("dim %d basis %d form %d step %d: node %zu nonzero after the reset", dim, b, m, s, i);
-            }
+            check_rows(sim, what, s, &ranged, &boxed);
           }
           if (!(ranged < 0.85 * boxed))
-            fail_msg("dim %d basis %d: the row ranges held %ld of the box's %ld nodes: the wedge "
-                     "does not exercise them", dim, b, ranged, boxed);
+            fail_msg("%s: the row ranges held %ld of the box's %ld nodes: the wedge does not "
+                     "exercise them", what, ranged, boxed);
           double *v;
           TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
           double vmax = 0.0;
           for (int q = 0; q < k; ++q) vmax = v[q * dim] > vmax ? v[q * dim] : vmax;
-          if (!(vmax > 0.05)) fail_msg("dim %d basis %d: the wedge does not slide (v_x %g)", dim, b, vmax);
+          if (!(vmax > 0.05)) fail_msg("%s: the wedge does not slide (v_x %g)", what, vmax);
           TCALL(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
           mpmc_sim_destroy(&sim);
           mpmc_context_destroy(&ctx);
           test_ctx = NULL;
         }
+}
+
+/* The mirrors' partners outside the points' row ranges: interior slip walls on the node
+ * planes x = 2.5 and y = 5.5 (material on their + sides), and on their constrained sides a
+ * block of points 0.5 to 1 m from each (x in [1.5, 2], y in [0.5, 1]; x in [5, 6], y in [4,
+ * 4.5]), sharing no node row: the ghost nodes of the B-splines and uGIMP within their reach
+ * carry mass, and the partners across the wall, which no point's stencil reaches, must join
+ * the rows' ranges (grid_update.c, grow_box_for_mirrors: the x wall's within a row, the y
+ * wall's as whole rows beyond the box). */
+static void test_row_ranges_mirrors(void **state) {
+  (void)state;
+  for (int b = 1; b < 4; ++b) {
+    mpmc_context ctx;
+    TCALL(mpmc_context_create(&ctx));
+    test_ctx = ctx;
+    mpmc_sim sim;
+    TCALL(mpmc_sim_create(ctx, 2, &sim));
+    const double lo[2] = {0, 0}, hi[2] = {8, 8};
+    TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.25));
+    TCALL(mpmc_sim_set_basis(sim, b));
+    TCALL(mpmc_sim_set_fbar(sim, MPMC_FBAR_PAPER));
+    int mat, wid;
+    TCALL(mpmc_sim_add_material_hencky(sim, 2e5, 0.3, 1000, &mat));
+    const double alo[2] = {1.5, 0.5}, ahi[2] = {2.0, 1.0}, blo[2] = {5.0, 4.0}, bhi[2] = {6.0, 4.5};
+    TCALL(mpmc_sim_seed_box(sim, alo, ahi, 2, mat, NULL, NULL));
+    TCALL(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, NULL));
+    TCALL(mpmc_sim_add_wall(sim, 0, -1, 2.5, MPMC_WALL_SLIP, &wid));
+    TCALL(mpmc_sim_add_wall(sim, 1, -1, 5.5, MPMC_WALL_SLIP, &wid));
+    TCALL(mpmc_sim_prepare(sim));
+    char what[64];
+    snprintf(what, sizeof what, "interior walls, basis %d", b);
+    long ranged = 0, boxed = 0;
+    for (int s = 0; s < 3; ++s) {
+      TCALL(mpmc_sim_step(sim, 1e-4));
+      check_rows(sim, what, s, &ranged, &boxed);
+    }
+    mpmc_sim_destroy(&sim);
+    mpmc_context_destroy(&ctx);
+    test_ctx = NULL;
+  }
 }
 
 /* The step leaves the gather to Hencky-J2's update when every material is Hencky-J2 (fbar.c,
@@ -468,6 +514,7 @@ int main(void) {
       cmocka_unit_test(test_nodal_mode),
       cmocka_unit_test(test_fb_cleared),
       cmocka_unit_test(test_row_ranges),
+      cmocka_unit_test(test_row_ranges_mirrors),
       cmocka_unit_test(test_deferred_gather),
       cmocka_unit_test(test_positions_held),
   };
