@@ -75,10 +75,7 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
     g->rowx = malloc(sizeof(int) * 2 * (size_t)g->n[1] * (size_t)g->n[2]);
     MPMC_CHECK(g->rowx, ctx, MPMC_ERR_MEMORY, "cannot allocate the ranges of %d grid rows",
                g->n[1] * g->n[2]);
-    for (size_t r = 0; r < (size_t)g->n[1] * (size_t)g->n[2]; ++r) {
-      g->rowx[2 * r] = 0;
-      g->rowx[2 * r + 1] = g->n[0];
-    }
+    mpmc_grid_rows_full(g); /* a box set before (mpmc_grid_clear) gets its rows */
   }
   if (with_fbar == MPMC_FBAR_STABLE) MPMC_CALL(alloc_d(ctx, &g->fb, nn * 2));
   if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fbj, nn + 4)); /* the gather reads 4 from a row start */
