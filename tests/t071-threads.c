@@ -11,6 +11,7 @@
 
 #include <cmocka.h>
 #include <limits.h>
+#include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 
@@ -195,9 +196,73 @@ static void test_slab_order(void **state) {
   mpmc_context_destroy(&ctx);
 }
 
+/* Each colour's slabs go to the threads in runs (p2g.c, slab_groups): for two and three
+ * threads, on a body whose slabs hold unequal numbers of points (a floor with a tower at one
+ * end), the runs of a colour cover its slabs in order, each slab once, each slab in the run
+ * of the thread whose share of the colour's points (the t-th nt-th) holds the slab's middle
+ * point, and so each thread's points differ from its share by at most the largest slab. */
+static void test_slab_groups(void **state) {
+  (void)state;
+  mpmc_context ctx;
+  mpmc_sim sim;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  TCALL(mpmc_sim_create(ctx, 3, &sim));
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1};
+  const double floor_hi[3] = {1.6, 0.7, 0.3}, tlo[3] = {0, 0, 0.3}, thi[3] = {0.4, 0.7, 0.9};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
+  int mat, n1, n2;
+  TCALL(mpmc_sim_add_material_hencky(sim, 1e6, 0.3, 1000, &mat));
+  TCALL(mpmc_sim_seed_box(sim, lo, floor_hi, 2, mat, NULL, &n1));
+  TCALL(mpmc_sim_seed_box(sim, tlo, thi, 2, mat, NULL, &n2));
+  TCALL(mpmc_sim_prepare(sim));
+  const int saved = omp_get_max_threads();
+  for (int nt = 2; nt <= 3; ++nt) {
+    omp_set_num_threads(nt);
+    TCALL(mpmc_slabs_build(sim));
+    const int ns = sim->nslab;
+    if (sim->slab_nt != nt) fail_msg("slab runs for %d threads, expected %d", sim->slab_nt, nt);
+    for (int c = 0; c < 2; ++c) {
+      long total = 0, kmax = 0;
+      for (int sl = c; sl < ns; sl += 2) {
+        const long k = sim->slab_start[sl + 1] - sim->slab_start[sl];
+        total += k;
+        kmax = k > kmax ? k : kmax;
+      }
+      const int end = c + 2 * ((ns - c + 1) / 2); /* the first slab index of colour c >= ns */
+      if (mpmc_slab_group(sim, c, 0) != c || mpmc_slab_group(sim, c, nt) != end)
+        fail_msg("%d threads, colour %d: runs from slab %d to %d, expected %d to %d", nt, c,
+                 mpmc_slab_group(sim, c, 0), mpmc_slab_group(sim, c, nt), c, end);
+      for (int t = 0; t < nt; ++t) {
+        const int s0 = mpmc_slab_group(sim, c, t), s1 = mpmc_slab_group(sim, c, t + 1);
+        if (s1 < s0 || (s0 - c) % 2 || (s1 - c) % 2)
+          fail_msg("%d threads, colour %d: thread %d's run %d .. %d", nt, c, t, s0, s1);
+        long pts = 0;
+        for (int sl = s0; sl < s1; sl += 2) {
+          long before = 0; /* the colour's points in the slabs before sl */
+          for (int o = c; o < sl; o += 2) before += sim->slab_start[o + 1] - sim->slab_start[o];
+          const long k = sim->slab_start[sl + 1] - sim->slab_start[sl];
+          const int owner = (int)floor((before + 0.5 * k) * nt / (double)total);
+          if ((owner < nt ? owner : nt - 1) != t)
+            fail_msg("%d threads, colour %d: slab %d (points %ld .. %ld of %ld) in thread %d's "
+                     "run, expected thread %d's", nt, c, sl, before, before + k, total, t,
+                     owner < nt ? owner : nt - 1);
+          pts += k;
+        }
+        if (labs(nt * pts - total) > nt * kmax)
+          fail_msg("%d threads, colour %d: thread %d has %ld of %ld points (largest slab %ld)",
+                   nt, c, t, pts, total, kmax);
+      }
+    }
+  }
+  omp_set_num_threads(saved);
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_2d_fbar), cmocka_unit_test(test_2d_ugimp_total),
                                      cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable), cmocka_unit_test(test_3d_compact),
-                                     cmocka_unit_test(test_slab_order)};
+                                     cmocka_unit_test(test_slab_order), cmocka_unit_test(test_slab_groups)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -232,8 +232,8 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   static void scatter_##D##_##B(mpmc_sim sim) {                                              \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
     for (int colour = 0; colour < 2; ++colour) {                                             \
-      _Pragma("omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)")          \
-      for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
+      MPMC_SLABS_OF(sim, colour, sl)                                                         \
         for (int k = start[sl]; k < start[sl + 1]; ++k) scatter_point(sim, D, B, order[k]);  \
     }                                                                                        \
   }                                                                                          \
@@ -272,8 +272,8 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   static void scatter_stable_##D##_##B(mpmc_sim sim) {                                       \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
     for (int colour = 0; colour < 2; ++colour) {                                             \
-      _Pragma("omp parallel for schedule(dynamic, 1) if (sim->p.n > MPMC_OMP_MIN)")          \
-      for (int sl = colour; sl < sim->nslab; sl += 2)                                        \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
+      MPMC_SLABS_OF(sim, colour, sl)                                                         \
         for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
           scatter_stable_point(sim, D, B, order[k]);                                         \
     }                                                                                        \

@@ -222,8 +222,8 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
 #define G2P_SLABS(D, B, FBV)                                                                  \
   do {                                                                                        \
     for (int colour = 0; colour < 2; ++colour) {                                              \
-      _Pragma("omp parallel for schedule(dynamic, 1) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
-      for (int sl = colour; sl < sim->nslab; sl += 2)                                         \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
+      MPMC_SLABS_OF(sim, colour, sl)                                                          \
         MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,       \
                       order, start[sl], start[sl + 1], q, l, w4,                              \
                       if (!g2p_point(sim, D, B, FBV, dt, c, fb0, q, &w4, l, &v2m) &&          \

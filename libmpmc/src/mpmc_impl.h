@@ -309,6 +309,10 @@ struct mpmc_sim_s {
   int *order;         /* [n] point indices grouped by slab                             */
   int *slab_start;    /* [nslab + 1] offsets into order                                */
   int nslab, slab_axis, cap_order, cap_slab;
+  /* the slabs of colour c that thread t scatters: c's slabs sl = group[c][t], + 2, ..., below
+   * group[c][t + 1], for t < slab_nt (mpmc_slab_group, MPMC_SLABS_OF) */
+  int *slab_group;    /* [2][slab_nt + 1] */
+  int slab_nt, cap_group;
   struct mpmc_bodies_s *bodies; /* rigid bodies and barrier contact (contact_barrier.c) */
   struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
   struct mpmc_sets_s *node_sets; /* named grid node sets (sets.c)                     */
@@ -334,6 +338,14 @@ struct mpmc_sim_s {
 /* Chunk t of nc consecutive chunks of [0, n): the first index; chunk t ends where t + 1
  * begins (the slab build, and P2G's and G2P's per-thread grids, split the points so) */
 static inline int mpmc_chunk_start(int n, int t, int nc) { return (int)((long long)n * t / nc); }
+/* Thread t's slabs of colour c run from mpmc_slab_group(sim, c, t) (in steps of two) to
+ * mpmc_slab_group(sim, c, t + 1) (p2g.c, slab_groups). */
+#define mpmc_slab_group(sim, c, t) ((sim)->slab_group[(c) * ((sim)->slab_nt + 1) + (t)])
+/* Loop header: the slabs sl of colour c, each thread its own run of them (slab_groups), in
+ * an OpenMP loop whose pragma (with clauses for the body's reductions) precedes it. */
+#define MPMC_SLABS_OF(sim, c, sl)                  \
+  for (int t_ = 0; t_ < (sim)->slab_nt; ++t_)      \
+    for (int sl = mpmc_slab_group(sim, c, t_); sl < mpmc_slab_group(sim, c, t_ + 1); sl += 2)
 /* The slab axis for points whose cells span [clo, chi] per axis: the outermost axis of the
  * grid's memory (z in 3D, y in 2D) when the points span MPMC_SLAB_PLANES cell planes along
  * it, else the longest extent, ties to the outermost.  p2g.c slabs along it and sort.c puts it

@@ -112,6 +112,7 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   free(s->mirrors);
   free(s->order);
   free(s->slab_start);
+  free(s->slab_group);
   free(s);
   *sim = NULL;
   return MPMC_SUCCESS;

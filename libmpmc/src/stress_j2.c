@@ -252,11 +252,17 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
     tid = omp_get_thread_num();
 #endif
     mpmc_rm_ws *w = ws[tid];
-    /* dynamic: plastic points cost several elastic ones and gather where the soil fails,
-     * which after a sort by cell is one stretch of the index range.  Chunks of J2_CHUNK
-     * blocks; with F-bar's gather deferred to here (grid.fb_gather, fbar.c) each chunk's
-     * points are gathered first, their dF-bar = scale dF formed as dF is loaded. */
-#pragma omp for schedule(dynamic, 1)
+    /* Static: each thread one contiguous half (nt-th) of the points, those it updated in
+     * G2P (its index chunk, or with F-bar about its slabs: p2g.c, slab_groups), whose fields
+     * are still in its core's caches.  Plastic points cost several elastic ones and gather
+     * where the soil fails, which after a sort by cell is one stretch of the index range,
+     * so a dynamic schedule balanced better; but it moved the points between the cores
+     * every step, which cost more (the landslide's states at the run-out's start and 4 s
+     * on two threads: the update 8.7 -> 7.7 and 9.6 -> 8.2 ms a step, docs/benchmarks.md).
+     * Chunks of J2_CHUNK blocks; with F-bar's gather deferred to here (grid.fb_gather,
+     * fbar.c) each chunk's points are gathered first, their dF-bar = scale dF formed as dF
+     * is loaded. */
+#pragma omp for schedule(static)
     for (int ch = 0; ch < nchunk; ++ch) {
       const int b0 = ch * J2_CHUNK, b1 = b0 + J2_CHUNK < nblk ? b0 + J2_CHUNK : nblk;
       const int c0 = 4 * b0, c1 = 4 * b1 < n ? 4 * b1 : n;
