@@ -199,8 +199,8 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   const int d = sim->dim, n = p->n;
   if (n == 0) {
     for (int a = 0; a < 3; ++a) g->act_lo[a] = g->act_hi[a] = 0;
-    sim->nslab = sim->slab_nt = 0;
-    return MPMC_SUCCESS;
+    sim->nslab = 0;
+    return slab_groups(sim, mpmc_max_threads()); /* empty runs, for one thread or more */
   }
   MPMC_CHECK(p->dF, sim->ctx, MPMC_ERR_STATE, "slabs: the points' fields are not allocated");
   if (n > sim->cap_order) {
