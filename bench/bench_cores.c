@@ -103,10 +103,10 @@ int main(int argc, char **argv) {
   }
 #pragma omp parallel for schedule(static) num_threads(2)
   for (size_t i = 0; i < n; ++i) a[i] = 0.0, b[i] = 1.0, c[i] = 2.0;
-  printf("test   unit                 1 thread  2 threads  ratio\n");
+  printf("test     unit                 1 thread  2 threads  ratio\n");
   for (int t = 0; t < 2; ++t) {
     const double r1 = rate(t, 1, secs, avx2, a, b, c, n), r2 = rate(t, 2, secs, avx2, a, b, c, n);
-    printf("%-6s %-20s %8.2f  %9.2f  %5.2f\n", t ? "triad" : "fma",
+    printf("%-8s %-20s %8.2f  %9.2f  %5.2f\n", t ? "triad" : "fma",
            t ? "GB/s" : avx2 ? "G flop/s (AVX2 FMA)" : "G flop/s (vectors)", r1, r2, r2 / r1);
   }
   free(a), free(b), free(c);
