@@ -137,8 +137,8 @@ static void row_ranges(mpmc_grid *g, int d, int nc, const int *clo, const int *c
 }
 
 /* Each colour's slabs split among the nt threads in runs of consecutive slabs, balanced by
- * points: a slab goes to the thread whose share of the colour's points (its t-th nt-th) most
- * of it falls in.  The runs, not a dynamic schedule, hand out the slabs, so that a thread
+ * points: a slab goes to the thread whose share of the colour's points (its t-th nt-th)
+ * holds the slab's middle point.  The runs, not a dynamic schedule, hand out the slabs, so that a thread
  * takes the same slabs every step while the points stay where they are, and (the points
  * sorted with the slab axis outermost, sort.c) about the points that it updates in G2P's
  * and the stress update's index ranges: its points and nodes are in its own core's caches
