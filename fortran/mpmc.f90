@@ -45,9 +45,10 @@ module mpmc
   integer(c_int), parameter, public :: MPMC_SOLVER_AUTO = 0, MPMC_SOLVER_NEWTON = 1, &
     MPMC_SOLVER_KINSOL = 2
   ! instruction set of the transfer kernels (baseline and avx2 the same results to the bit;
-  ! fma, the default where the processor has AVX2, fused multiply-adds: round-off apart)
+  ! fma, fused multiply-adds: round-off apart; avx512, fma for AVX-512 with fma's bits, the
+  ! default where the processor has AVX-512, else fma where it has AVX2)
   integer(c_int), parameter, public :: MPMC_KERNELS_AUTO = 0, MPMC_KERNELS_BASELINE = 1, &
-    MPMC_KERNELS_AVX2 = 2, MPMC_KERNELS_FMA = 3
+    MPMC_KERNELS_AVX2 = 2, MPMC_KERNELS_FMA = 3, MPMC_KERNELS_AVX512 = 4
   ! particle fields
   integer(c_int), parameter, public :: MPMC_FIELD_POSITION = 0, MPMC_FIELD_VELOCITY = 1, &
     MPMC_FIELD_MASS = 2, MPMC_FIELD_VOLUME0 = 3, MPMC_FIELD_J = 4, MPMC_FIELD_JBAR = 5, &

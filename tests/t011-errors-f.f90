@@ -61,8 +61,10 @@ program t011_errors_f
     'get_kernels = BASELINE')
   call check(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AUTO) == MPMC_SUCCESS, 'set_kernels(AUTO)')
   call check(mpmc_sim_get_kernels(sim, id) == MPMC_SUCCESS .and. (id == MPMC_KERNELS_BASELINE &
-    .or. id == MPMC_KERNELS_FMA), 'get_kernels after AUTO is a concrete set')
+    .or. id == MPMC_KERNELS_FMA .or. id == MPMC_KERNELS_AVX512), 'get_kernels after AUTO is a concrete set')
   call expect_str('mpmc_kernels_name(MPMC_KERNELS_FMA)', 'fma', mpmc_kernels_name(MPMC_KERNELS_FMA))
+  call expect_str('mpmc_kernels_name(MPMC_KERNELS_AVX512)', 'avx512', &
+    mpmc_kernels_name(MPMC_KERNELS_AVX512))
   call expect_str('mpmc_kernels_name(MPMC_KERNELS_BASELINE)', 'baseline', &
     mpmc_kernels_name(MPMC_KERNELS_BASELINE))
   call expect_str('mpmc_kernels_name(7)', 'unknown kernel set', mpmc_kernels_name(7_c_int))

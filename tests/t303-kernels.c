@@ -2,7 +2,7 @@
  * the same scene stepped once with each set, on the same number of threads, every particle
  * field compared with memcmp; the FMA kernels (fused multiply-adds) agree with them to
  * round-off, and in an optimised build differ from them somewhere (else they would not be
- * fused).  The scenes cover both dimensions, all four bases, F-bar off,
+ * fused); where the processor has AVX-512, the AVX512 kernels give the FMA kernels' bits.  The scenes cover both dimensions, all four bases, F-bar off,
  * Algorithm 1, the total and the stable form, elastic, plastic and rigid-body contact forces, damping and
  * walls (mirrored ghosts).  Also the set/get calls and the MPMC_KERNELS variable. */
 #include <setjmp.h>
@@ -79,11 +79,13 @@ static double fma_rel;
 static int fma_close, fma_differs;
 
 static void check_scene(const scene *sc) {
-  mpmc_context c[3];
-  mpmc_sim s[3];
+  mpmc_context c[4];
+  mpmc_sim s[4];
+  const int nset = mpmc_kernels_avx512_available() ? 4 : 3; /* avx512 where it runs */
   run(sc, MPMC_KERNELS_BASELINE, &c[0], &s[0]);
   run(sc, MPMC_KERNELS_AVX2, &c[1], &s[1]);
   run(sc, MPMC_KERNELS_FMA, &c[2], &s[2]);
+  if (nset == 4) run(sc, MPMC_KERNELS_AVX512, &c[3], &s[3]);
   int n;
   TCALL(mpmc_sim_get_num_particles(s[0], &n));
   int compared = 0;
@@ -97,6 +99,16 @@ static void check_scene(const scene *sc) {
     assert_int_equal(na, nb);
     assert_int_equal(na, nm);
     const size_t len = (size_t)n * (size_t)na;
+    if (nset == 4) { /* avx512: fma's operations and contractions, so fma's bits */
+      double *e;
+      int ne;
+      TCALL(mpmc_sim_get_field(s[3], f, &e, &ne));
+      assert_int_equal(na, ne);
+      for (size_t i = 0; i < len; ++i)
+        if (memcmp(&m[i], &e[i], sizeof(double)))
+          fail_msg("dim %d basis %d fbar %d: field %d, entry %zu: fma %.17g, avx512 %.17g",
+                   sc->dim, sc->basis, sc->fbar, f, i, m[i], e[i]);
+    }
     if (memcmp(a, b, sizeof(double) * len)) {
       for (size_t i = 0; i < len; ++i)
         if (memcmp(&a[i], &b[i], sizeof(double)))
@@ -121,7 +133,7 @@ static void check_scene(const scene *sc) {
   if (compared < 5) fail_msg("only %d fields compared", compared);
   fma_rel = fmax(fma_rel, scene_rel);
   fma_close += scene_rel <= 1e-9;
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < nset; ++k) {
     mpmc_sim_destroy(&s[k]);
     mpmc_context_destroy(&c[k]);
   }
@@ -155,6 +167,13 @@ static void same_bits(void **state) {
            "the largest difference %.3g of it\n", fma_close, nsc, fma_rel);
 }
 
+/* what AUTO resolves to on this processor */
+static int auto_set(void) {
+  return mpmc_kernels_avx512_available() ? MPMC_KERNELS_AVX512
+         : mpmc_kernels_avx2_available() ? MPMC_KERNELS_FMA
+                                         : MPMC_KERNELS_BASELINE;
+}
+
 static void set_get(void **state) {
   (void)state;
   mpmc_context ctx;
@@ -164,21 +183,22 @@ static void set_get(void **state) {
   TCALL(mpmc_sim_create(ctx, 2, &sim));
   int k = -1;
   TCALL(mpmc_sim_get_kernels(sim, &k));
-  assert_int_equal(k, mpmc_kernels_avx2_available() ? MPMC_KERNELS_FMA : MPMC_KERNELS_BASELINE);
+  assert_int_equal(k, auto_set());
   TCALL(mpmc_sim_set_kernels(sim, MPMC_KERNELS_BASELINE));
   TCALL(mpmc_sim_get_kernels(sim, &k));
   assert_int_equal(k, MPMC_KERNELS_BASELINE);
   TCALL(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AUTO)); /* AUTO resolves to a set */
   TCALL(mpmc_sim_get_kernels(sim, &k));
-  assert_int_equal(k, mpmc_kernels_avx2_available() ? MPMC_KERNELS_FMA : MPMC_KERNELS_BASELINE);
-  assert_int_equal(mpmc_sim_set_kernels(sim, 4), MPMC_ERR_ARG);
-  assert_non_null(strstr(mpmc_context_last_error(ctx), "kernels = 4"));
+  assert_int_equal(k, auto_set());
+  assert_int_equal(mpmc_sim_set_kernels(sim, 5), MPMC_ERR_ARG);
+  assert_non_null(strstr(mpmc_context_last_error(ctx), "kernels = 5"));
   /* the names MPMC_KERNELS and summary.json use */
   assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_AUTO), "auto");
   assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_BASELINE), "baseline");
   assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_AVX2), "avx2");
   assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_FMA), "fma");
-  assert_string_equal(mpmc_kernels_name(4), "unknown kernel set");
+  assert_string_equal(mpmc_kernels_name(MPMC_KERNELS_AVX512), "avx512");
+  assert_string_equal(mpmc_kernels_name(5), "unknown kernel set");
   assert_string_equal(mpmc_kernels_name(-1), "unknown kernel set");
   assert_int_equal(mpmc_sim_get_kernels(sim, NULL), MPMC_ERR_ARG);
   if (!mpmc_kernels_avx2_available()) {
@@ -190,6 +210,16 @@ static void set_get(void **state) {
     TCALL(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AVX2));
     TCALL(mpmc_sim_get_kernels(sim, &k));
     assert_int_equal(k, MPMC_KERNELS_AVX2);
+  }
+  if (!mpmc_kernels_avx512_available()) { /* refused, saying what is missing */
+    assert_int_equal(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AVX512), MPMC_ERR_ARG);
+    assert_non_null(strstr(mpmc_context_last_error(ctx), "kernels = avx512 (4)"));
+    assert_non_null(strstr(mpmc_context_last_error(ctx),
+                           mpmc_kernels_avx2_available() ? "no AVX-512" : "no AVX2"));
+  } else {
+    TCALL(mpmc_sim_set_kernels(sim, MPMC_KERNELS_AVX512));
+    TCALL(mpmc_sim_get_kernels(sim, &k));
+    assert_int_equal(k, MPMC_KERNELS_AVX512);
   }
   mpmc_sim_destroy(&sim);
   /* the environment variable: a valid name sets the default, anything else is an error
@@ -205,6 +235,18 @@ static void set_get(void **state) {
     TCALL(mpmc_sim_get_kernels(sim, &k));
     assert_int_equal(k, MPMC_KERNELS_AVX2);
     mpmc_sim_destroy(&sim);
+  }
+  setenv("MPMC_KERNELS", "avx512", 1); /* made where it runs, else refused by name */
+  sim = NULL;
+  if (mpmc_kernels_avx512_available()) {
+    TCALL(mpmc_sim_create(ctx, 3, &sim));
+    TCALL(mpmc_sim_get_kernels(sim, &k));
+    assert_int_equal(k, MPMC_KERNELS_AVX512);
+    mpmc_sim_destroy(&sim);
+  } else {
+    assert_int_equal(mpmc_sim_create(ctx, 3, &sim), MPMC_ERR_ARG);
+    assert_null(sim);
+    assert_non_null(strstr(mpmc_context_last_error(ctx), "MPMC_KERNELS = avx512"));
   }
   setenv("MPMC_KERNELS", "sse9", 1);
   sim = NULL;

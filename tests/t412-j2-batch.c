@@ -136,13 +136,14 @@ static void run_dim(int dim, int solver) {
     fail_msg("dim %d: weak mix: %d plastic, %d by KINSOL, %d outside the series", dim, plastic,
              fallbacks, series_out);
   TCALL(mpmc_sim_set_solver(sim, solver));
-  state got[3];
+  state got[4];
   /* each set against the scalar update; baseline and AVX2 also against each other, bit for
-   * bit (FMA's fused multiply-adds part from them by round-off) */
-  const int sets[3] = {MPMC_KERNELS_BASELINE, MPMC_KERNELS_AVX2, MPMC_KERNELS_FMA};
+   * bit (FMA's fused multiply-adds part from them by round-off), and FMA and AVX512 */
+  const int sets[4] = {MPMC_KERNELS_BASELINE, MPMC_KERNELS_AVX2, MPMC_KERNELS_FMA,
+                       MPMC_KERNELS_AVX512};
   int nsets = 0;
-  for (int s = 0; s < 3; ++s) {
-    if (mpmc_sim_set_kernels(sim, sets[s])) { /* no AVX2 here */
+  for (int s = 0; s < 4; ++s) {
+    if (mpmc_sim_set_kernels(sim, sets[s])) { /* no AVX2 (or AVX-512) here */
       mpmc_context_clear_error(ctx);
       continue;
     }
@@ -175,9 +176,12 @@ static void run_dim(int dim, int solver) {
         fail_msg("dim %d point %d: eps_p %.17g, scalar %.17g", dim, q, g->eps_p[q], want.eps_p[q]);
     }
   }
-  if (nsets == 3 && (memcmp(got[0].be, got[1].be, sizeof got[0].be) || memcmp(got[0].stress, got[1].stress, sizeof got[0].stress) ||
+  if (nsets >= 3 && (memcmp(got[0].be, got[1].be, sizeof got[0].be) || memcmp(got[0].stress, got[1].stress, sizeof got[0].stress) ||
                      memcmp(got[0].eps_p, got[1].eps_p, sizeof got[0].eps_p)))
     fail_msg("dim %d: baseline and AVX2 stress updates differ", dim);
+  if (nsets == 4 && (memcmp(got[2].be, got[3].be, sizeof got[0].be) || memcmp(got[2].stress, got[3].stress, sizeof got[0].stress) ||
+                     memcmp(got[2].eps_p, got[3].eps_p, sizeof got[0].eps_p)))
+    fail_msg("dim %d: FMA and AVX512 stress updates differ", dim);
   /* a non-finite dF in the middle of a block: the error names the point */
   memcpy(p->be, be0, sizeof be0);
   memcpy(p->eps_p, ep0, sizeof ep0);

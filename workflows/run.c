@@ -201,6 +201,7 @@ static int build(wf_run *w) {
 
 /* the kernel set in use and what it is, for the log */
 static const char *kernels_detail(int k) {
+  if (k == MPMC_KERNELS_AVX512) return "avx512 (x86-64-v4, fused multiply-adds, fma's results)";
   if (k == MPMC_KERNELS_FMA) return "fma (x86-64-v3, fused multiply-adds)";
   if (k == MPMC_KERNELS_AVX2) return "avx2 (x86-64-v3)";
   return mpmc_kernels_name(k);

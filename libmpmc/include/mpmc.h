@@ -79,22 +79,26 @@ typedef enum {
 } mpmc_solver;
 
 /* Instruction set of the step's transfer kernels (P2G, grid update, G2P, F-bar, the
- * Hencky-J2 update; mpmc_sim_set_kernels).  On x86-64 the library carries them three times:
- * for any x86-64, for x86-64-v3 (AVX2) with the same results to the bit, and for x86-64-v3
- * with fused multiply-adds, the fastest (about 10 % on the 3D landslide), whose results
- * differ from the other two by round-off. */
+ * Hencky-J2 update; mpmc_sim_set_kernels).  On x86-64 the library carries them four times:
+ * for any x86-64, for x86-64-v3 (AVX2) with the same results to the bit, for x86-64-v3
+ * with fused multiply-adds (about 10 % faster on the 3D landslide), whose results differ
+ * from the other two by round-off, and the latter for x86-64-v4 (AVX-512), with the fused
+ * set's results to the bit (GCC 12, tests/t303) and a few per cent faster where the
+ * processor has it. */
 typedef enum {
-  MPMC_KERNELS_AUTO = 0,     /* FMA where the processor has AVX2, else BASELINE (the  */
-                             /* default); the environment variable MPMC_KERNELS=     */
-                             /* auto|baseline|avx2|fma read by mpmc_sim_create       */
-                             /* overrides the default                                */
+  MPMC_KERNELS_AUTO = 0,     /* AVX512 where the processor has AVX-512, else FMA     */
+                             /* where it has AVX2, else BASELINE (the default); the  */
+                             /* environment variable MPMC_KERNELS=auto|baseline|     */
+                             /* avx2|fma|avx512 read by mpmc_sim_create overrides it */
   MPMC_KERNELS_BASELINE = 1, /* the build's own target (any x86-64 by default)       */
   MPMC_KERNELS_AVX2 = 2,     /* x86-64-v3, BASELINE's bits; refused where the build  */
                              /* or CPU lacks it                                      */
-  MPMC_KERNELS_FMA = 3       /* x86-64-v3 with fused multiply-adds; refused likewise */
+  MPMC_KERNELS_FMA = 3,      /* x86-64-v3 with fused multiply-adds; refused likewise */
+  MPMC_KERNELS_AVX512 = 4    /* FMA for x86-64-v4 (AVX-512F/BW/CD/DQ/VL), FMA's bits; */
+                             /* refused where the build or CPU lacks it              */
 } mpmc_kernels;
 /* The kernel set's name as MPMC_KERNELS and summary.json spell it ("auto", "baseline",
- * "avx2", "fma"); "unknown kernel set" outside the list. */
+ * "avx2", "fma", "avx512"); "unknown kernel set" outside the list. */
 const char *mpmc_kernels_name(int kernels);
 
 /* Particle fields, readable (and writable) in place.  ncomp per particle in brackets. */

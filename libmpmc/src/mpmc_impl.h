@@ -365,12 +365,17 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
 }
 
 /* The step's kernel phases (p2g.c, grid_update.c, g2p.c, fbar.c, stress_j2.c) exist once per
- * instruction set: CMakeLists.txt compiles these files twice more for x86-64-v3 (AVX2), with
- * MPMC_ISA_AVX2 defined, which appends _avx2 to their external names, and with MPMC_ISA_FMA
- * (_fma) and fused multiply-adds allowed.  A sim runs one set (sim->kernels,
- * mpmc_sim_set_kernels); baseline and avx2 give the same bits, as ISO C mode allows no
- * floating-point contraction (tests/t303); fma differs from them by round-off. */
-#if defined(MPMC_ISA_FMA)
+ * instruction set: CMakeLists.txt compiles these files three times more, for x86-64-v3 (AVX2)
+ * with MPMC_ISA_AVX2 defined, which appends _avx2 to their external names, with MPMC_ISA_FMA
+ * (_fma) and fused multiply-adds allowed, and as fma for x86-64-v4 (AVX-512) with
+ * MPMC_ISA_AVX512 (_avx512; MPMC_ISA_FMA defined as well, the source's fma paths being its
+ * own).  A sim runs one set (sim->kernels, mpmc_sim_set_kernels); baseline and avx2 give the
+ * same bits, as ISO C mode allows no floating-point contraction (tests/t303); fma differs
+ * from them by round-off; avx512 gives fma's bits with this compiler (t303 checks it): the
+ * same operations, contracted alike, in the 32 vector registers of AVX-512's encoding. */
+#if defined(MPMC_ISA_AVX512)
+#define MPMC_ISA(fn) fn##_avx512
+#elif defined(MPMC_ISA_FMA)
 #define MPMC_ISA(fn) fn##_fma
 #elif defined(MPMC_ISA_AVX2)
 #define MPMC_ISA(fn) fn##_avx2
@@ -389,6 +394,7 @@ MPMC_KERNEL_PROTOTYPES()
 #if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2) || defined(MPMC_ISA_FMA)
 MPMC_KERNEL_PROTOTYPES(_avx2)
 MPMC_KERNEL_PROTOTYPES(_fma)
+MPMC_KERNEL_PROTOTYPES(_avx512)
 #endif
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
 /* the step's stress guard (stress_update.c): 0 if a component of s (Voigt) is NaN or Inf */
@@ -398,6 +404,8 @@ static inline int mpmc_stress_finite(const double *s) {
 /* 1 if this build carries the AVX2 kernels (avx2 and fma) and the processor (and OS) runs
  * them (sim.c) */
 int mpmc_kernels_avx2_available(void);
+/* 1 if the AVX-512 kernels (avx512) can run here likewise (sim.c) */
+int mpmc_kernels_avx512_available(void);
 
 /* sort.c: before a step, sort the points by cell if the sort interval has passed */
 int mpmc_sort_due(struct mpmc_sim_s *sim);

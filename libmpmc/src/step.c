@@ -29,8 +29,11 @@ static const kernel_set avx2 = {mpmc_slabs_build_avx2, mpmc_p2g_avx2, mpmc_grid_
                                 mpmc_g2p_avx2, mpmc_fbar_avx2};
 static const kernel_set fused = {mpmc_slabs_build_fma, mpmc_p2g_fma, mpmc_grid_update_fma,
                                  mpmc_g2p_fma, mpmc_fbar_fma};
+static const kernel_set avx512 = {mpmc_slabs_build_avx512, mpmc_p2g_avx512,
+                                  mpmc_grid_update_avx512, mpmc_g2p_avx512, mpmc_fbar_avx512};
 #define KERNELS(sim)                                  \
-  ((sim)->kernels == MPMC_KERNELS_FMA    ? &fused    \
+  ((sim)->kernels == MPMC_KERNELS_AVX512 ? &avx512   \
+   : (sim)->kernels == MPMC_KERNELS_FMA  ? &fused    \
    : (sim)->kernels == MPMC_KERNELS_AVX2 ? &avx2     \
                                          : &baseline)
 #else
