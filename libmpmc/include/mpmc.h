@@ -174,7 +174,8 @@ int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
 int mpmc_sim_set_solver(mpmc_sim sim, int solver);
 int mpmc_sim_set_threads(mpmc_sim sim, int nthreads);
 int mpmc_sim_set_kernels(mpmc_sim sim, int kernels);      /* mpmc_kernels */
-int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels); /* the set in use: BASELINE, AVX2, FMA */
+/* the set in use: BASELINE, AVX2, FMA or AVX512 */
+int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels);
 
 /* ---- materials; each returns its id ----------------------------------------- */
 int mpmc_sim_add_material_neo_hookean(mpmc_sim sim, double E, double nu, double rho, int *id);
