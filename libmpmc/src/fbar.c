@@ -161,25 +161,31 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
   return projection_scale(p, DIM, q, gather_dot(BASIS, &t.w[0][0][0], 4, &acc), inv);
 }
 
-/* gather_scale for the four points q .. q + 3 of t into scale[0..3], each lane with the
- * same operations as one point alone (same bits): the row sums point by point, then, with
- * them transposed, gather_dot, the reciprocals and the cube roots near 1 as vectors. */
-MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BASIS,
-                                      const mpmc_pw4 *t, int q, double *scale) {
-  mpmc_particles *p = &sim->p;
-  const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
+/* The projected Jacobians pi of the four points of t (lanes), each lane with the same
+ * operations as one point alone (same bits): the row sums point by point, then, with them
+ * transposed, gather_dot as a vector. */
+MPMC_ALWAYS_INLINE void gather_pi4(const mpmc_grid *g, const int DIM, const int BASIS,
+                                   const mpmc_pw4 *t, mpmc_b4d *pip) {
   mpmc_b4d a[4];
   for (int l = 0; l < 4; ++l)
-    gather_rows(&sim->grid, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l],
-                4, &a[l]);
+    gather_rows(g, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l], 4, &a[l]);
   /* c[i] = (a[0][i], .., a[3][i]): lanes the points, as t's weights */
   mpmc_b4d c[4];
   mpmc_transpose4(a, c);
   const mpmc_b4da *wx = (const mpmc_b4da *)t->w[0];
   mpmc_b4d pi = wx[0] * c[0];
   for (int i = 1; i < mpmc_stencil(BASIS); ++i) pi = MADD4V(wx[i], c[i], pi);
+  *pip = pi;
+}
+
+/* Points q .. q + 3 from their pi and inv = 1 / (Jbar^n dJ): pi into Jbar, the factors of
+ * their dF into scale[0..3]; the reciprocals and the cube roots near 1 as vectors. */
+MPMC_ALWAYS_INLINE void gather_finish4(mpmc_particles *p, const int DIM, int q,
+                                       const mpmc_b4d *pip, const mpmc_b4d *invp,
+                                       double *scale) {
+  const mpmc_b4d pi = *pip;
   *(mpmc_b4du *)(p->Jbar + q) = pi;
-  const mpmc_b4d r = pi * inv, e = r - 1.0;
+  const mpmc_b4d r = pi * *invp, e = r - 1.0;
   const mpmc_b4l magn = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX}; /* all but the sign */
   const mpmc_b4l small = (mpmc_b4d)((mpmc_b4l)e & magn) < 0.004;       /* |e| < 0.004, not NaN */
 #if defined(__AVX__)
@@ -193,6 +199,32 @@ MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BAS
   } else {
     for (int l = 0; l < 4; ++l) scale[l] = DIM == 2 ? sqrt(r[l]) : cbrt_near1(r[l]);
   }
+}
+
+/* gather_scale for the four points q .. q + 3 of t into scale[0..3], each lane with the
+ * same operations as one point alone (same bits). */
+MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BASIS,
+                                      const mpmc_pw4 *t, int q, double *scale) {
+  mpmc_particles *p = &sim->p;
+  const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
+  mpmc_b4d pi;
+  gather_pi4(&sim->grid, DIM, BASIS, t, &pi);
+  gather_finish4(p, DIM, q, &pi, &inv, scale);
+}
+
+/* gather_scale4 for the eight points q .. q + 7 of t[0] and t[1]: the two fours' sums side
+ * by side, so that the processor works on both dependency chains (weights, row sums, the
+ * transpose, the dot) at once; the same operations per point, so the same bits. */
+MPMC_ALWAYS_INLINE void gather_scale8(mpmc_sim sim, const int DIM, const int BASIS,
+                                      const mpmc_pw4 *t, int q, double *scale) {
+  mpmc_particles *p = &sim->p;
+  const mpmc_b4d inv0 = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
+  const mpmc_b4d inv1 = 1.0 / *(const mpmc_b4du *)(p->Jbar + q + 4);
+  mpmc_b4d pi0, pi1;
+  gather_pi4(&sim->grid, DIM, BASIS, &t[0], &pi0);
+  gather_pi4(&sim->grid, DIM, BASIS, &t[1], &pi1);
+  gather_finish4(p, DIM, q, &pi0, &inv0, scale);
+  gather_finish4(p, DIM, q + 4, &pi1, &inv1, scale + 4);
 }
 
 MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
@@ -248,9 +280,16 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
     if (sim->fbar == MPMC_FBAR_STABLE) {                                                     \
       for (int q = q0; q < q1; ++q)                                                          \
         if (mat[q] == id) scale[q - q0] = gather_stable_scale(sim, D, B, xs, q);             \
-    } else { /* four points at a time, then the rest */                                     \
+    } else { /* eight (one material) or four points at a time, then the rest */             \
       int q = q0;                                                                            \
       const int one = sim->nmat == 1; /* every point is id's */                             \
+      for (; one && q + 8 <= q1; q += 8) {                                                   \
+        const int idx[8] = {q, q + 1, q + 2, q + 3, q + 4, q + 5, q + 6, q + 7};             \
+        mpmc_pw4 t[2]; /* the same bits as mpmc_point_weights1 per point */                 \
+        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t[0]);                 \
+        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx + 4, &t[1]);             \
+        gather_scale8(sim, D, B, t, q, scale + (q - q0));                                    \
+      }                                                                                      \
       for (; q + 4 <= q1; q += 4) {                                                          \
         if (!one && mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id) \
           continue;                                                                          \
