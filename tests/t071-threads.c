@@ -123,17 +123,25 @@ static void test_3d_compact(void **state) {
  * a slab the points by plane and within a plane in index order (points stored at random).
  * The order does not depend on how the points were split among the threads (one thread gives
  * the same permutation), nor on the axis the build started from (the last step's). */
+/* The slab tests' sim: a 2 x 1 x 1 m grid of 0.1 m cells and an elastic material (*mat),
+ * no points yet; lo the grid's corner, the origin. */
+static const double slab_lo[3] = {0, 0, 0};
+static void slab_sim(mpmc_context *ctx, mpmc_sim *sim, int *mat) {
+  TCALL(mpmc_context_create(ctx));
+  test_ctx = *ctx;
+  TCALL(mpmc_sim_create(*ctx, 3, sim));
+  const double hi[3] = {2, 1, 1};
+  TCALL(mpmc_sim_set_grid(*sim, slab_lo, hi, 0.1));
+  TCALL(mpmc_sim_add_material_hencky(*sim, 1e6, 0.3, 1000, mat));
+}
+
 static void test_slab_order(void **state) {
   (void)state;
   mpmc_context ctx;
   mpmc_sim sim;
-  TCALL(mpmc_context_create(&ctx));
-  test_ctx = ctx;
-  TCALL(mpmc_sim_create(ctx, 3, &sim));
-  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1}, bhi[3] = {1.6, 0.7, 0.8};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
   int mat, n;
-  TCALL(mpmc_sim_add_material_hencky(sim, 1e6, 0.3, 1000, &mat));
+  slab_sim(&ctx, &sim, &mat);
+  const double *lo = slab_lo, bhi[3] = {1.6, 0.7, 0.8};
   TCALL(mpmc_sim_seed_box(sim, lo, bhi, 2, mat, NULL, &n));
   if (n <= 4096) fail_msg("expected more than MPMC_OMP_MIN points, got %d", n);
   double *x;
@@ -205,15 +213,10 @@ static void test_slab_groups(void **state) {
   (void)state;
   mpmc_context ctx;
   mpmc_sim sim;
-  TCALL(mpmc_context_create(&ctx));
-  test_ctx = ctx;
-  TCALL(mpmc_sim_create(ctx, 3, &sim));
-  const double lo[3] = {0, 0, 0}, hi[3] = {2, 1, 1};
-  const double floor_hi[3] = {1.6, 0.7, 0.3}, tlo[3] = {0, 0, 0.3}, thi[3] = {0.4, 0.7, 0.9};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
   int mat, n1, n2;
-  TCALL(mpmc_sim_add_material_hencky(sim, 1e6, 0.3, 1000, &mat));
-  TCALL(mpmc_sim_seed_box(sim, lo, floor_hi, 2, mat, NULL, &n1));
+  slab_sim(&ctx, &sim, &mat);
+  const double floor_hi[3] = {1.6, 0.7, 0.3}, tlo[3] = {0, 0, 0.3}, thi[3] = {0.4, 0.7, 0.9};
+  TCALL(mpmc_sim_seed_box(sim, slab_lo, floor_hi, 2, mat, NULL, &n1));
   TCALL(mpmc_sim_seed_box(sim, tlo, thi, 2, mat, NULL, &n2));
   TCALL(mpmc_sim_prepare(sim));
   const int saved = omp_get_max_threads();
