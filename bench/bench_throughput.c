@@ -11,7 +11,14 @@
  * the environment the rates are per second of the process's CPU time (all threads) instead
  * of wall-clock time: on a shared, loaded machine that is the steadier measure of the code's
  * cost.  With MPMC_BENCH_PHASES set each row is followed by the share of the step's wall time
- * per phase (mpmc_stats.phase_seconds) of its last run. */
+ * per phase (mpmc_stats.phase_seconds) of its last run.  With MPMC_BENCH_SHARE=R set, the
+ * table (none with a case beyond it, e.g. 99) is followed by F-bar's share of the standard
+ * step on the column, one thread: the steps without and with each form (B-spline2 and uGIMP,
+ * Algorithm 1 and stable) run alternately for R rounds in this one process, and each round's
+ * share is rate(off) / rate(on) - 1 of its adjacent pair (the machine's drift, slow against a
+ * round, cancels in a pair).  Printed per form: the median and range of the R shares; the
+ * share from the best rate of each (the runs least disturbed by other load, on a busy host
+ * the steadier figure); each phase's least ms a step over the rounds, off and on. */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -42,6 +49,7 @@ static double bytes_per_point(const mpmc_sim sim) {
 static double last_bytes;
 static int shuffle_points, sort_every, use_cpu_time;
 static double last_phase[MPMC_PHASE_COUNT]; /* the last run's share of the step per phase */
+static double last_phase_ms[MPMC_PHASE_COUNT + 1]; /* its ms a step per phase, then the step */
 
 static double now(void) {
   struct timespec ts;
@@ -117,12 +125,72 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
   for (int s = 0; s < steps; ++s) CHECK(mpmc_sim_step(sim, dt));
   const double t = now() - t0;
   CHECK(mpmc_sim_get_stats(sim, &st1));
-  for (int k = 0; k < MPMC_PHASE_COUNT; ++k)
+  for (int k = 0; k < MPMC_PHASE_COUNT; ++k) {
     last_phase[k] = (st1.phase_seconds[k] - st0.phase_seconds[k]) / (st1.wall_seconds - st0.wall_seconds);
+    last_phase_ms[k] = 1e3 * (st1.phase_seconds[k] - st0.phase_seconds[k]) / steps;
+  }
+  last_phase_ms[MPMC_PHASE_COUNT] = 1e3 * (st1.wall_seconds - st0.wall_seconds) / steps;
   last_bytes = bytes_per_point(sim);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   return (double)(*np) * steps / t;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* MPMC_BENCH_SHARE: F-bar's share, off and on alternated in rounds (see the file's comment) */
+static void fbar_shares(int rounds, int steps, double scale) {
+  static const struct {
+    int basis, fbar;
+    const char *name;
+  } forms[] = {{MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, "bspline2 paper"},
+               {MPMC_BASIS_UGIMP, MPMC_FBAR_PAPER, "ugimp paper"},
+               {MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, "bspline2 stable"},
+               {MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, "ugimp stable"}};
+  enum { NF = sizeof forms / sizeof forms[0] };
+  const int nf = NF;
+  double *sh = malloc(sizeof(double) * (size_t)rounds * (size_t)nf), best[NF][2] = {{0}};
+  double least[NF][2][MPMC_PHASE_COUNT + 1];
+  if (!sh) return;
+  for (int f = 0; f < nf; ++f)
+    for (int o = 0; o < 2; ++o)
+      for (int k = 0; k <= MPMC_PHASE_COUNT; ++k) least[f][o][k] = INFINITY;
+  for (int r = 0; r < rounds; ++r)
+    for (int f = 0; f < nf; ++f) {
+      int np;
+      /* off first in even rounds, on first in odd ones */
+      const int first = r % 2 ? forms[f].fbar : 0, second = r % 2 ? 0 : forms[f].fbar;
+      const double a = run(1, forms[f].basis, first, 1, 1, steps, scale, &np);
+      for (int k = 0; k <= MPMC_PHASE_COUNT; ++k)
+        least[f][first != 0][k] = fmin(least[f][first != 0][k], last_phase_ms[k]);
+      const double b = run(1, forms[f].basis, second, 1, 1, steps, scale, &np);
+      for (int k = 0; k <= MPMC_PHASE_COUNT; ++k)
+        least[f][second != 0][k] = fmin(least[f][second != 0][k], last_phase_ms[k]);
+      const double off = first ? b : a, on = first ? a : b;
+      sh[f * rounds + r] = off / on - 1.0;
+      best[f][0] = off > best[f][0] ? off : best[f][0];
+      best[f][1] = on > best[f][1] ? on : best[f][1];
+    }
+  printf("F-bar's share of the step on the column, one thread, %d rounds of %d steps alternated "
+         "(rate off / rate on - 1):\n", rounds, steps);
+  for (int f = 0; f < nf; ++f) {
+    double *v = sh + f * rounds;
+    qsort(v, (size_t)rounds, sizeof *v, cmp_double);
+    const double med = rounds % 2 ? v[rounds / 2] : 0.5 * (v[rounds / 2 - 1] + v[rounds / 2]);
+    printf("  %-16s median %+6.1f %%  range %+6.1f .. %+6.1f %%  best rates %.3f / %.3f M/s: "
+           "%+6.1f %%\n", forms[f].name, 100 * med, 100 * v[0], 100 * v[rounds - 1],
+           best[f][0] / 1e6, best[f][1] / 1e6, 100 * (best[f][0] / best[f][1] - 1.0));
+    printf("    least ms a step, off -> on:");
+    for (int k = 0; k <= MPMC_PHASE_COUNT; ++k)
+      if (least[f][1][k] > 0.0005)
+        printf(" %s %.3f -> %.3f", k < MPMC_PHASE_COUNT ? mpmc_phase_name(k) : "step",
+               least[f][0][k], least[f][1][k]);
+    printf("\n");
+  }
+  free(sh);
 }
 
 int main(int argc, char **argv) {
@@ -170,5 +238,7 @@ int main(int argc, char **argv) {
     }
     fflush(stdout);
   }
+  const char *share = getenv("MPMC_BENCH_SHARE");
+  if (share && atoi(share) > 0) fbar_shares(atoi(share), steps, scale);
   return 0;
 }
