@@ -165,16 +165,7 @@ static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) 
   int64_t nret = 0, nfb = 0;
   int first_bad = INT_MAX;
   /* the points in blocks of four (stress_j2.c), in the sim's instruction set */
-#ifdef MPMC_HAVE_AVX2_KERNELS
-  if (sim->kernels == MPMC_KERNELS_AVX512)
-    MPMC_CALL(mpmc_j2_batch_avx512(sim, mat, id, ws, &nret, &nfb, &first_bad));
-  else if (sim->kernels == MPMC_KERNELS_FMA)
-    MPMC_CALL(mpmc_j2_batch_fma(sim, mat, id, ws, &nret, &nfb, &first_bad));
-  else if (sim->kernels == MPMC_KERNELS_AVX2)
-    MPMC_CALL(mpmc_j2_batch_avx2(sim, mat, id, ws, &nret, &nfb, &first_bad));
-  else
-#endif
-    MPMC_CALL(mpmc_j2_batch(sim, mat, id, ws, &nret, &nfb, &first_bad));
+  MPMC_CALL(mpmc_kernels_j2_batch(sim)(sim, mat, id, ws, &nret, &nfb, &first_bad));
   sim->stats.return_maps += nret;
   sim->stats.kinsol_fallbacks += nfb;
   if (first_bad == INT_MAX) return MPMC_SUCCESS;
