@@ -151,15 +151,14 @@ static void fbar_shares(int rounds, int steps, double scale) {
                {MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, "bspline2 stable"},
                {MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, "ugimp stable"}};
   enum { NF = sizeof forms / sizeof forms[0] };
-  const int nf = NF;
-  double *sh = malloc(sizeof(double) * (size_t)rounds * (size_t)nf), best[NF][2] = {{0}};
+  double *sh = malloc(sizeof(double) * (size_t)rounds * NF), best[NF][2] = {{0}};
   double least[NF][2][MPMC_PHASE_COUNT + 1];
   if (!sh) return;
-  for (int f = 0; f < nf; ++f)
+  for (int f = 0; f < NF; ++f)
     for (int o = 0; o < 2; ++o)
       for (int k = 0; k <= MPMC_PHASE_COUNT; ++k) least[f][o][k] = INFINITY;
   for (int r = 0; r < rounds; ++r)
-    for (int f = 0; f < nf; ++f) {
+    for (int f = 0; f < NF; ++f) {
       int np;
       /* off first in even rounds, on first in odd ones */
       const int first = r % 2 ? forms[f].fbar : 0, second = r % 2 ? 0 : forms[f].fbar;
@@ -176,7 +175,7 @@ static void fbar_shares(int rounds, int steps, double scale) {
     }
   printf("F-bar's share of the step on the column, one thread, %d rounds of %d steps alternated "
          "(rate off / rate on - 1):\n", rounds, steps);
-  for (int f = 0; f < nf; ++f) {
+  for (int f = 0; f < NF; ++f) {
     double *v = sh + f * rounds;
     qsort(v, (size_t)rounds, sizeof *v, cmp_double);
     const double med = rounds % 2 ? v[rounds / 2] : 0.5 * (v[rounds / 2 - 1] + v[rounds / 2]);

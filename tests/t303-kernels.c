@@ -2,9 +2,10 @@
  * the same scene stepped once with each set, on the same number of threads, every particle
  * field compared with memcmp; the FMA kernels (fused multiply-adds) agree with them to
  * round-off, and in an optimised build differ from them somewhere (else they would not be
- * fused); where the processor has AVX-512, the AVX512 kernels give the FMA kernels' bits.  The scenes cover both dimensions, all four bases, F-bar off,
- * Algorithm 1, the total and the stable form, elastic, plastic and rigid-body contact forces, damping and
- * walls (mirrored ghosts).  Also the set/get calls and the MPMC_KERNELS variable. */
+ * fused); where the processor has AVX-512, the AVX512 kernels give the FMA kernels' bits.
+ * The scenes cover both dimensions, all four bases, F-bar off, Algorithm 1, the total and
+ * the stable form, elastic, plastic and rigid-body contact forces, damping and walls
+ * (mirrored ghosts).  Also the set/get calls and the MPMC_KERNELS variable. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
