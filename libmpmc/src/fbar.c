@@ -259,6 +259,43 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
   for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
 }
 
+/* The gather's factors of points q0 .. q1 - 1 at positions xs (Algorithm 1, step 4) into
+ * scale[q - q0], in the paper and total forms: of material id's points (id < 0: of every
+ * point; the others' entries and Jbar left alone).  Eight points at a time where they are all
+ * gathered, else four, then one by one: each lane with the operations of gather_scale, so the
+ * same bits as point by point. */
+MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, const double *xs,
+                                      int id, int q0, int q1, double *scale) {
+  const int *restrict mat = sim->p.mat;
+  const int one = id < 0 || sim->nmat == 1; /* every point is gathered */
+  int q = q0;
+  for (; one && q + 8 <= q1; q += 8) {
+    const int idx[8] = {q, q + 1, q + 2, q + 3, q + 4, q + 5, q + 6, q + 7};
+    mpmc_pw4 t[2]; /* the same bits as mpmc_point_weights1 per point */
+    mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t[0]);
+    mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx + 4, &t[1]);
+    gather_scale8(sim, D, B, t, q, scale + (q - q0));
+  }
+  for (; q + 4 <= q1; q += 4) {
+    if (!one && mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id)
+      continue;
+    const int idx[4] = {q, q + 1, q + 2, q + 3};
+    mpmc_pw4 t; /* the same bits as mpmc_point_weights1 per point */
+    mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t);
+    if (one || (mat[q] == id && mat[q + 1] == id && mat[q + 2] == id && mat[q + 3] == id))
+      gather_scale4(sim, D, B, &t, q, scale + (q - q0));
+    else /* materials mixed: the others' scale and Jbar left alone */
+      for (int l = 0; l < 4; ++l)
+        if (mat[q + l] == id) scale[q + l - q0] = gather_scale(sim, D, B, xs, q + l);
+  }
+  for (; q < q1; ++q)
+    if (one || mat[q] == id) scale[q - q0] = gather_scale(sim, D, B, xs, q);
+}
+
+/* points the gather of the fbar phase takes at a time (the deferred one goes by the J2
+ * update's chunks: stress_j2.c) */
+#define GATHER_CHUNK 256
+
 /* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
 #define FBAR_KERNELS(D, B)                                                                   \
   static void scatter_##D##_##B(mpmc_sim sim) {                                              \
@@ -269,9 +306,19 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
         for (int k = start[sl]; k < start[sl + 1]; ++k) scatter_point(sim, D, B, order[k]);  \
     }                                                                                        \
   }                                                                                          \
+  /* every point's, GATHER_CHUNK at a time, its dF scaled in place (x^n still in x) */      \
   static void gather_##D##_##B(mpmc_sim sim) {                                               \
-    _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
-    for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, 0, q);                        \
+    const int n = sim->p.n, nch = (n + GATHER_CHUNK - 1) / GATHER_CHUNK;                     \
+    _Pragma("omp parallel for schedule(static) if (n > MPMC_OMP_MIN)")                       \
+    for (int ch = 0; ch < nch; ++ch) {                                                       \
+      const int q0 = ch * GATHER_CHUNK, q1 = q0 + GATHER_CHUNK < n ? q0 + GATHER_CHUNK : n;  \
+      double scale[GATHER_CHUNK];                                                            \
+      gather_points(sim, D, B, sim->p.x, -1, q0, q1, scale);                                 \
+      for (int q = q0; q < q1; ++q) {                                                        \
+        double *dF = sim->p.dF + (size_t)q * D * D;                                          \
+        for (int k = 0; k < D * D; ++k) dF[k] *= scale[q - q0];                              \
+      }                                                                                      \
+    }                                                                                        \
   }                                                                                          \
   /* the deferred gather of points q0 .. q1 - 1 of material id (x^n in xn by then) */        \
   static void gather_range_##D##_##B(mpmc_sim sim, int id, int q0, int q1, double *scale) {  \
@@ -280,30 +327,8 @@ MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASI
     if (sim->fbar == MPMC_FBAR_STABLE) {                                                     \
       for (int q = q0; q < q1; ++q)                                                          \
         if (mat[q] == id) scale[q - q0] = gather_stable_scale(sim, D, B, xs, q);             \
-    } else { /* eight (one material) or four points at a time, then the rest */             \
-      int q = q0;                                                                            \
-      const int one = sim->nmat == 1; /* every point is id's */                             \
-      for (; one && q + 8 <= q1; q += 8) {                                                   \
-        const int idx[8] = {q, q + 1, q + 2, q + 3, q + 4, q + 5, q + 6, q + 7};             \
-        mpmc_pw4 t[2]; /* the same bits as mpmc_point_weights1 per point */                 \
-        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t[0]);                 \
-        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx + 4, &t[1]);             \
-        gather_scale8(sim, D, B, t, q, scale + (q - q0));                                    \
-      }                                                                                      \
-      for (; q + 4 <= q1; q += 4) {                                                          \
-        if (!one && mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id) \
-          continue;                                                                          \
-        const int idx[4] = {q, q + 1, q + 2, q + 3};                                         \
-        mpmc_pw4 t; /* the same bits as mpmc_point_weights1 per point */                     \
-        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t);                    \
-        if (one || (mat[q] == id && mat[q + 1] == id && mat[q + 2] == id && mat[q + 3] == id)) \
-          gather_scale4(sim, D, B, &t, q, scale + (q - q0));                                 \
-        else /* materials mixed: the others' scale and Jbar left alone */                    \
-          for (int l = 0; l < 4; ++l)                                                        \
-            if (mat[q + l] == id) scale[q + l - q0] = gather_scale(sim, D, B, xs, q + l);    \
-      }                                                                                      \
-      for (; q < q1; ++q)                                                                    \
-        if (mat[q] == id) scale[q - q0] = gather_scale(sim, D, B, xs, q);                    \
+    } else {                                                                                 \
+      gather_points(sim, D, B, xs, id, q0, q1, scale);                                       \
     }                                                                                        \
   }                                                                                          \
   /* the stable form's supports reach no further than the cubic B-spline's (nodes c - 1 ..  \
