@@ -42,6 +42,7 @@ static double bytes_per_point(const mpmc_sim sim) {
            {p->cforce, d},     {p->ustate, p->nustate},          {p->dF, d * d},
            {p->xn, d}};
   double b = sizeof(int) * (p->id ? 3.0 : 2.0); /* material id, slab order, point id (sort) */
+  if (sim->fb_scale) b += sizeof(double); /* F-bar's deferred factors (stress_j2.c) */
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
     if (f[i].a) b += sizeof(double) * (double)f[i].n;
   return b;

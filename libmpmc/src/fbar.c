@@ -23,6 +23,7 @@
  * records' MPMC_VSLOT. */
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "transfer.h"
@@ -352,10 +353,11 @@ MPMC_KERNELS(FBAR_KERNELS)
  * holds every point's support in every form (the cubic B-spline's reach, c - 1 .. c + 2, is
  * the widest; the stable form's spaces reach no further; t302 checks it).
  * defer: the step's call.  When every material's update runs the gather itself
- * (ops->gathers_fbar: Hencky-J2), the gather is left to it (grid.fb_gather): each chunk of
- * points is gathered where the update loads its dF, which then is read once and written
- * never instead of read, scaled, written and read again (the landslide's points do not fit
- * in the cache: a pass less over 311,250 of them).  Same bits either way. */
+ * (ops->gathers_fbar: Hencky-J2), the gather is left to it (grid.fb_gather): each thread
+ * gathers its points' factors into sim->fb_scale (allocated here) just before it updates
+ * them, and the update scales dF as it loads it, so dF is read once and written never
+ * instead of read, scaled, written and read again (the landslide's points do not fit in the
+ * cache: a pass less over 311,250 of them).  Same bits either way. */
 int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   mpmc_grid *g = &sim->grid;
   const int stable = sim->fbar == MPMC_FBAR_STABLE;
@@ -389,9 +391,16 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
       }
     }
   }
+  if (defer && sim->p.n > sim->cap_fb_scale) {
+    double *a = realloc(sim->fb_scale, sizeof(double) * (size_t)sim->p.n);
+    MPMC_CHECK(a, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate F-bar's factors of %d points",
+               sim->p.n);
+    sim->fb_scale = a;
+    sim->cap_fb_scale = sim->p.n;
+  }
   g->fb_gather = defer;
   if (defer)
-    ; /* the material update gathers, from xn (mpmc_fbar_gather_range) */
+    ; /* the material update gathers, from xn (mpmc_fbar_gather_range), into sim->fb_scale */
   else if (stable)
     MPMC_KERNEL_CALL(gather_stable_, sim, sim);
   else

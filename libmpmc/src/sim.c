@@ -129,6 +129,7 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   free(s->walls);
   free(s->mirrors);
   free(s->order);
+  free(s->fb_scale);
   free(s->slab_start);
   free(s->slab_group);
   free(s);

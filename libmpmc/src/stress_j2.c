@@ -259,15 +259,25 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
      * so a dynamic schedule balanced better; but it moved the points between the cores
      * every step, which cost more (the landslide's states at the run-out's start and 4 s
      * on two threads: the update 8.7 -> 7.7 and 9.6 -> 8.2 ms a step, docs/benchmarks.md).
-     * Chunks of J2_CHUNK blocks; with F-bar's gather deferred to here (grid.fb_gather,
-     * fbar.c) each chunk's points are gathered first, their dF-bar = scale dF formed as dF
-     * is loaded. */
+     * Chunks of J2_CHUNK blocks.  With F-bar's gather deferred to here (grid.fb_gather,
+     * fbar.c) each thread first gathers all of its chunks' points into sim->fb_scale, then
+     * updates them, forming dF-bar = scale dF as dF is loaded; the two loops' static
+     * schedules give a thread the same chunks, so it reads only factors it wrote (nowait).
+     * Gathered chunk by chunk between the updates instead, the update's streams (dF, b_e,
+     * stress) waited behind the gather's (x^n, Jbar): docs/benchmarks.md. */
+    if (gather) {
+#pragma omp for schedule(static) nowait
+      for (int ch = 0; ch < nchunk; ++ch) {
+        const int b0 = ch * J2_CHUNK, b1 = b0 + J2_CHUNK < nblk ? b0 + J2_CHUNK : nblk;
+        const int c0 = 4 * b0, c1 = 4 * b1 < n ? 4 * b1 : n;
+        MPMC_ISA(mpmc_fbar_gather_range)(sim, id, c0, c1, sim->fb_scale + c0); /* [q - c0] */
+      }
+    }
 #pragma omp for schedule(static)
     for (int ch = 0; ch < nchunk; ++ch) {
       const int b0 = ch * J2_CHUNK, b1 = b0 + J2_CHUNK < nblk ? b0 + J2_CHUNK : nblk;
-      const int c0 = 4 * b0, c1 = 4 * b1 < n ? 4 * b1 : n;
-      double scale[4 * J2_CHUNK];
-      if (gather) MPMC_ISA(mpmc_fbar_gather_range)(sim, id, c0, c1, scale);
+      const int c0 = 4 * b0;
+      const double *scale = gather ? sim->fb_scale + c0 : NULL; /* [q - c0] */
       for (int blk = b0; blk < b1; ++blk) {
         const int q0 = 4 * blk;
         int act[4], nact = 0;
