@@ -251,12 +251,9 @@ MPMC_ALWAYS_INLINE double gather_stable_scale(mpmc_sim sim, const int DIM, const
   return projection_scale(p, DIM, q, pi, inv);
 }
 
-/* Gather point q in the form of the sim (STABLE: the stable one) and scale its dF. */
-MPMC_ALWAYS_INLINE void gather_point(mpmc_sim sim, const int DIM, const int BASIS, const int STABLE,
-                                     int q) {
-  const double scale = STABLE ? gather_stable_scale(sim, DIM, BASIS, sim->p.x, q)
-                              : gather_scale(sim, DIM, BASIS, sim->p.x, q);
-  double *dF = sim->p.dF + (size_t)q * DIM * DIM;
+/* dF-bar = scale dF of point q, in place */
+MPMC_ALWAYS_INLINE void scale_dF(mpmc_particles *p, const int DIM, int q, double scale) {
+  double *dF = p->dF + (size_t)q * DIM * DIM;
   for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
 }
 
@@ -315,10 +312,7 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
       const int q0 = ch * GATHER_CHUNK, q1 = q0 + GATHER_CHUNK < n ? q0 + GATHER_CHUNK : n;  \
       double scale[GATHER_CHUNK];                                                            \
       gather_points(sim, D, B, sim->p.x, -1, q0, q1, scale);                                 \
-      for (int q = q0; q < q1; ++q) {                                                        \
-        double *dF = sim->p.dF + (size_t)q * D * D;                                          \
-        for (int k = 0; k < D * D; ++k) dF[k] *= scale[q - q0];                              \
-      }                                                                                      \
+      for (int q = q0; q < q1; ++q) scale_dF(&sim->p, D, q, scale[q - q0]);                  \
     }                                                                                        \
   }                                                                                          \
   /* the deferred gather of points q0 .. q1 - 1 of material id (x^n in xn by then) */        \
@@ -345,7 +339,8 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
   }                                                                                          \
   static void gather_stable_##D##_##B(mpmc_sim sim) {                                        \
     _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
-    for (int q = 0; q < sim->p.n; ++q) gather_point(sim, D, B, 1, q);                        \
+    for (int q = 0; q < sim->p.n; ++q)                                                       \
+      scale_dF(&sim->p, D, q, gather_stable_scale(sim, D, B, sim->p.x, q));                  \
   }
 MPMC_KERNELS(FBAR_KERNELS)
 

@@ -303,12 +303,12 @@ struct mpmc_sim_s {
   double time;
   mpmc_stats stats;
   void *solver_ws;    /* return-mapping workspaces (return_map.c), per thread          */
-  /* race-free scatter (p2g.c): points bucketed into slabs of at least MPMC_SLAB_W cells
-   * along one axis; slabs of one colour (parity) never touch the same node, so they run in
-   * parallel */
   double *fb_scale;   /* [n] F-bar's factors of dF, the deferred gather's (stress_j2.c);
                          scratch within a step, allocated by fbar.c when first needed  */
   int cap_fb_scale;
+  /* race-free scatter (p2g.c): points bucketed into slabs of at least MPMC_SLAB_W cells
+   * along one axis; slabs of one colour (parity) never touch the same node, so they run in
+   * parallel */
   int *order;         /* [n] point indices grouped by slab                             */
   int *slab_start;    /* [nslab + 1] offsets into order                                */
   int nslab, slab_axis, cap_order, cap_slab;
