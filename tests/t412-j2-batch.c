@@ -38,25 +38,17 @@ static int same_bits(const state *a, const state *b) {
 }
 
 static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
-  mpmc_sim sim;
-  TCALL(mpmc_sim_create(ctx, dim, &sim));
-  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
+  mpmc_sim sim = test_unit_box_sim(ctx, dim);
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e7, 0.3, 2000, 3e4, 5e3, 8, &mats[0]));
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 5e7, 0.49, 1800, 2e5, 2e5, 0, &mats[1]));
   TCALL(mpmc_sim_add_material_hencky(sim, 1e7, 0.3, 2000, &mats[2]));
   /* eta (kappa_p - kappa_r) = 3e6 > 3G = 1.15e6: g' > 0 near the bracket's lower end */
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e6, 0.3, 2000, 1.2e4, 2e3, 300, &mats[3]));
-  for (int q = 0; q < NP; ++q) {
-    const double x[3] = {0.3 + 0.004 * q, 0.5, 0.5}, v = 1e-4;
-    /* J2 A mostly, J2 B every third point, Hencky every seventh, the steep J2 every fifth:
-     * blocks mix materials */
-    const int m = q % 7 == 3   ? mats[2]
-                  : q % 5 == 4 ? mats[3]
-                  : q % 3 == 1 ? mats[1]
-                               : mats[0];
-    TCALL(mpmc_sim_add_particles(sim, 1, x, &v, m, NULL));
-  }
+  int mat[NP];
+  for (int q = 0; q < NP; ++q) /* J2 A mostly, J2 B every third point, Hencky every seventh,
+                                  the steep J2 every fifth: blocks mix materials */
+    mat[q] = q % 7 == 3 ? mats[2] : q % 5 == 4 ? mats[3] : q % 3 == 1 ? mats[1] : mats[0];
+  test_points_on_line(sim, NP, mat);
   TCALL(mpmc_sim_prepare(sim));
   return sim;
 }
@@ -66,27 +58,11 @@ static void fill(mpmc_sim sim) {
   mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   for (int q = 0; q < NP; ++q) {
-    double R[3][3], A[3][3], lam[3];
-    rand_rotation(R);
-    if (d == 2) { /* plane strain: b_e keeps yz = xz = 0, a rotation about z */
-      const double t = 2.0 * M_PI * urand();
-      const double R2[3][3] = {{cos(t), -sin(t), 0}, {sin(t), cos(t), 0}, {0, 0, 1}};
-      memcpy(R, R2, sizeof R);
-    }
     /* a few beyond the series (|eps| > 0.18), half of the rest inside the yield surface */
     const double big = q % 11 == 5 ? 0.4 : q % 2 ? 0.001 : 0.02;
-    for (int a = 0; a < 3; ++a) lam[a] = exp(2.0 * big * (2.0 * urand() - 1.0));
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        A[i][j] = 0;
-        for (int a = 0; a < 3; ++a) A[i][j] += R[i][a] * lam[a] * R[j][a];
-      }
-    for (int i = 0; i < 3; ++i)
-      for (int j = i; j < 3; ++j) p->be[q * 6 + mpmc_voigt(i, j)] = A[i][j];
+    rand_spd(d, big, p->be + q * 6);
     p->eps_p[q] = q % 4 == 0 ? 0.0 : loguni(1e-6, 0.5);
-    const double s = loguni(1e-9, 0.01);
-    for (int i = 0; i < d; ++i)
-      for (int j = 0; j < d; ++j) p->dF[q * d * d + i * d + j] = (i == j) + s * (2.0 * urand() - 1.0);
+    rand_dF(d, loguni(1e-9, 0.01), p->dF + q * d * d);
     for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
   }
 }
@@ -221,17 +197,12 @@ static void guard(int dim, int with_hencky) {
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
-  mpmc_sim sim;
-  TCALL(mpmc_sim_create(ctx, dim, &sim));
-  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
-  int m, h;
+  mpmc_sim sim = test_unit_box_sim(ctx, dim);
+  int m, h, mat[NP];
   TCALL(mpmc_sim_add_material_hencky_j2(sim, 1e304, 0.49999, 2000, 1e307, 1e307, 0, &m));
   if (with_hencky) TCALL(mpmc_sim_add_material_hencky(sim, 1e7, 0.3, 2000, &h));
-  for (int q = 0; q < NP; ++q) {
-    const double x[3] = {0.3 + 0.004 * q, 0.5, 0.5}, v = 1e-4;
-    TCALL(mpmc_sim_add_particles(sim, 1, x, &v, m, NULL));
-  }
+  for (int q = 0; q < NP; ++q) mat[q] = m;
+  test_points_on_line(sim, NP, mat);
   TCALL(mpmc_sim_prepare(sim));
   mpmc_particles *p = &sim->p;
   for (int q = 0; q < NP; ++q)

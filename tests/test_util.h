@@ -31,6 +31,25 @@ static mpmc_context test_ctx __attribute__((unused));
       fail_msg("%s = %.17g, expected %.17g (tolerance %g)", #got, tg_, tw_, tt_);           \
   } while (0)
 
+/* A sim of dimension dim on the unit box, cells of 0.1 (the batched stress updates' tests,
+ * t412 and t413: points on a line, test_points_on_line). */
+static inline mpmc_sim test_unit_box_sim(mpmc_context ctx, int dim) {
+  mpmc_sim sim;
+  TCALL(mpmc_sim_create(ctx, dim, &sim));
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.1));
+  return sim;
+}
+
+/* n points on the line x = 0.3 + 0.004 q, y = z = 0.5, point q of material mat[q], v = 1e-4
+ * along x */
+static inline void test_points_on_line(mpmc_sim sim, int n, const int *mat) {
+  for (int q = 0; q < n; ++q) {
+    const double x[3] = {0.3 + 0.004 * q, 0.5, 0.5}, v = 1e-4;
+    TCALL(mpmc_sim_add_particles(sim, 1, x, &v, mat[q], NULL));
+  }
+}
+
 /* Seed a box [lo, hi] (whole cells of size h) with ppc points per cell per axis.
  * Returns the number of points; x and vol are malloc'ed. */
 static inline int test_lattice(int dim, const double *lo, const double *hi, double h, int ppc,

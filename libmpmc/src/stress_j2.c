@@ -21,27 +21,14 @@
 #include <omp.h>
 #endif
 
-#include "basis.h"
+#include "batch4.h"
 #include "linalg.h"
 #include "return_map.h"
 #if defined(__AVX__)
 #include <immintrin.h>
 #endif
 
-typedef double v4 __attribute__((vector_size(4 * sizeof(double))));
-typedef double v4u __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
-typedef double v2u __attribute__((vector_size(2 * sizeof(double)), aligned(8), may_alias));
-typedef long long l4 __attribute__((vector_size(4 * sizeof(long long))));
 #define J2_CHUNK 64 /* blocks of four points handed to a thread at a time */
-
-/* sqrt per lane (through pointers: vectors by value would change the baseline build's ABI) */
-static inline void sqrt4(const v4 *x, v4 *r) {
-#if defined(__AVX__)
-  *r = (v4)_mm256_sqrt_pd((__m256d)*x);
-#else
-  for (int l = 0; l < 4; ++l) (*r)[l] = sqrt((*x)[l]);
-#endif
-}
 
 /* lanes of a where mask m is set, else of b; |a| per lane; the mask's lanes as bits */
 #define SEL4(m, a, b) ((v4)(((m) & (l4)(a)) | (~(m) & (l4)(b))))
@@ -59,39 +46,6 @@ static inline double max_lane(const v4 *r, const l4 *m) {
   double x = 0.0;
   for (int l = 0; l < 4; ++l) x = v[l] > x ? v[l] : x;
   return x;
-}
-
-/* v[k][l] = src[w l + k], k < 8: the first eight of four points' rows of w >= 8 doubles */
-static inline void load_rows8(const double *src, int w, v4 *v) {
-  v4 r[4];
-  for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + w * l);
-  mpmc_transpose4(r, v);
-  for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + w * l + 4);
-  mpmc_transpose4(r, v + 4);
-}
-
-/* v[k][l] = src[6 l + k]: four points' rows of six (store_rows6's inverse) */
-static inline void load_rows6(const double *src, v4 *v) {
-  v4 r[4];
-  for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(src + 6 * l);
-  mpmc_transpose4(r, v);
-  const v4 x = {src[4], src[5], src[16], src[17]}, y = {src[10], src[11], src[22], src[23]};
-  v[4] = __builtin_shuffle(x, y, (l4){0, 4, 2, 6});
-  v[5] = __builtin_shuffle(x, y, (l4){1, 5, 3, 7});
-}
-
-/* The six components of four points, v[k][l], stored as the points' rows of six at dst
- * (dst + 6 l: point l's), by a transpose and two shuffles instead of 24 lane extractions */
-static inline void store_rows6(const v4 *v, double *dst) {
-  v4 r[4];
-  mpmc_transpose4(v, r);
-  const v4 t0 = __builtin_shuffle(v[4], v[5], (l4){0, 4, 2, 6}),
-           t1 = __builtin_shuffle(v[4], v[5], (l4){1, 5, 3, 7});
-  for (int l = 0; l < 4; ++l) *(v4u *)(dst + 6 * l) = r[l];
-  *(v2u *)(dst + 4) = (v2u){t0[0], t0[1]};
-  *(v2u *)(dst + 10) = (v2u){t1[0], t1[1]};
-  *(v2u *)(dst + 16) = (v2u){t0[2], t0[3]};
-  *(v2u *)(dst + 22) = (v2u){t1[2], t1[3]};
 }
 
 /* c = a b for symmetric a, b (Voigt) that commute, as mpmc_sym3_mul */
@@ -287,21 +241,9 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
           /* four points of this material: whole vectors (lane by lane through memory, the
            * vectors' loads would wait on four scalar stores each; in 2D that stall was the
            * update's largest cost); in 2D dF's 2x2 in the plane, the rest of the identity */
-          const double *f = p->dF + (size_t)q0 * d * d, *be = p->be + (size_t)q0 * 6;
           const v4 sc = gather ? (v4)*(const v4u *)(scale + (q0 - c0)) : (v4){1.0, 1.0, 1.0, 1.0};
-          if (d == 3) {
-            load_rows8(f, 9, F);
-            F[8] = (v4){f[8], f[17], f[26], f[35]};
-            for (int k = 0; k < 9; ++k) F[k] *= sc;
-          } else { /* dF's 2 x 2 rows of four points, transposed: components xx, xy, yx, yy */
-            v4 r[4], c[4];
-            for (int l = 0; l < 4; ++l) r[l] = *(const v4u *)(f + 4 * l);
-            mpmc_transpose4(r, c);
-            for (int k = 0; k < 9; ++k) {
-              const int i = k / 3, j = k % 3;
-              F[k] = i < 2 && j < 2 ? c[2 * i + j] * sc : (v4){i == j, i == j, i == j, i == j};
-            }
-          }
+          load_dF4(d, p->dF + (size_t)q0 * d * d, &sc, F);
+          const double *be = p->be + (size_t)q0 * 6;
           load_rows6(be, b);
           for (int l = 0; l < 4; ++l) act[l] = 1;
           nact = 4;
@@ -323,18 +265,8 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
             }
           }
         if (!nact) continue;
-        /* trial b = F b_e F^T (mpmc_push_forward's order): T = F B, then T F^T's upper half */
-        const v4 B[3][3] = {{b[0], b[5], b[4]}, {b[5], b[1], b[3]}, {b[4], b[3], b[2]}};
-        v4 T[3][3];
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            T[i][j] = F[3 * i] * B[0][j] + F[3 * i + 1] * B[1][j] + F[3 * i + 2] * B[2][j];
-        v4 bt[6];
-        static const int vi[6] = {0, 1, 2, 1, 0, 0}, vj[6] = {0, 1, 2, 2, 2, 1};
-        for (int k = 0; k < 6; ++k) {
-          const int i = vi[k], j = vj[k];
-          bt[k] = T[i][0] * F[3 * j] + T[i][1] * F[3 * j + 1] + T[i][2] * F[3 * j + 2];
-        }
+        v4 bt[6]; /* trial b = F b_e F^T */
+        push_forward4(F, b, bt);
         v4 eps[6], e[6];
         const l4 am = {-(long long)act[0], -(long long)act[1], -(long long)act[2],
                        -(long long)act[3]};

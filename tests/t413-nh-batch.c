@@ -1,0 +1,168 @@
+/* The Neo-Hookean stress update over blocks of four points (stress_elastic.c) against the
+ * formula point by point (b <- dF b dF^T, tau = mu (b - 1) + lambda ln J 1, sigma = tau / J,
+ * with linalg.h's push-forward and determinant): 2D and 3D, a point count that leaves a
+ * partial last block, two Neo-Hookean materials and a Hencky one interleaved (blocks that mix
+ * materials go point by point), b from near I to stretches of 1.5; the baseline and AVX2 sets
+ * give the formula's bits, the FMA and AVX512 sets agree to round-off (and with each other,
+ * bit for bit); the update keeps the step's guard: a point whose stress overflows stops it
+ * with MPMC_ERR_NUMERIC naming that point, from a block of four and from a mixed block. */
+#include <limits.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "linalg.h"
+#include "mpmc_impl.h"
+#include "test_util.h"
+
+#define TEST_RNG_SEED 0x9E3779B97F4A7C15ull
+#include "test_rand.h"
+
+#define NP 103
+
+static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
+  mpmc_sim sim = test_unit_box_sim(ctx, dim);
+  TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e6, 0.45, 2000, &mats[0]));
+  TCALL(mpmc_sim_add_material_neo_hookean(sim, 70, 0.499, 1, &mats[1]));
+  TCALL(mpmc_sim_add_material_hencky(sim, 1e7, 0.3, 2000, &mats[2]));
+  int mat[NP];
+  for (int q = 0; q < NP; ++q) /* the first 40 points all of material A (whole blocks), then
+                                  B every third point and Hencky every seventh: mixed blocks */
+    mat[q] = q < 40 ? mats[0] : q % 7 == 3 ? mats[2] : q % 3 == 1 ? mats[1] : mats[0];
+  test_points_on_line(sim, NP, mat);
+  TCALL(mpmc_sim_prepare(sim));
+  return sim;
+}
+
+/* random inputs: b SPD with stretches up to 1.5 (b_zz too in 2D: the formula takes any b),
+ * dF of strain magnitudes 1e-9 .. 0.05 */
+static void fill(mpmc_sim sim) {
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  for (int q = 0; q < NP; ++q) {
+    rand_spd(d, q % 5 == 2 ? 0.4 : q % 2 ? 1e-6 : 0.02, p->be + q * 6);
+    rand_dF(d, loguni(1e-9, 0.05), p->dF + q * d * d);
+    for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
+  }
+}
+
+static void run_dim(int dim) {
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  int mats[3];
+  mpmc_sim sim = make(ctx, dim, mats);
+  mpmc_particles *p = &sim->p;
+  fill(sim);
+  static double be0[6 * NP], dF0[9 * NP], want_be[6 * NP], want_s[6 * NP];
+  static double got_be[4][6 * NP], got_s[4][6 * NP];
+  memcpy(be0, p->be, sizeof be0);
+  memcpy(dF0, p->dF, sizeof(double) * NP * dim * dim);
+  /* the expected state, point by point (material_neo_hookean.c's formula) */
+  for (int q = 0; q < NP; ++q) {
+    double *b = want_be + 6 * q, *s = want_s + 6 * q;
+    memcpy(b, be0 + 6 * q, sizeof(double) * 6);
+    for (int k = 0; k < 6; ++k) s[k] = 0.0;
+    if (p->mat[q] == mats[2]) continue; /* Hencky: not this update's */
+    const mpmc_material *m = &sim->mats[p->mat[q]];
+    double F[3][3];
+    mpmc_embed(dim, dF0 + q * dim * dim, F);
+    mpmc_push_forward(F, b);
+    const double J = sqrt(mpmc_det_sym(b));
+    const double lnJ = log(J), inv_J = 1.0 / J;
+    for (int k = 0; k < 6; ++k) s[k] = (m->G * (b[k] - (k < 3)) + (k < 3 ? m->lambda * lnJ : 0.0)) * inv_J;
+  }
+  const int sets[4] = {MPMC_KERNELS_BASELINE, MPMC_KERNELS_AVX2, MPMC_KERNELS_FMA,
+                       MPMC_KERNELS_AVX512};
+  int ran[4] = {0, 0, 0, 0};
+  for (int s = 0; s < 4; ++s) {
+    if (mpmc_sim_set_kernels(sim, sets[s])) { /* no AVX2 (or AVX-512) here */
+      mpmc_context_clear_error(ctx);
+      continue;
+    }
+    ran[s] = 1;
+    memcpy(p->be, be0, sizeof be0);
+    memcpy(p->dF, dF0, sizeof(double) * NP * dim * dim);
+    for (int k = 0; k < 6 * NP; ++k) p->stress[k] = 0.0;
+    sim->stress_bad = INT_MAX;
+    for (int k = 0; k < 2; ++k) {
+      const int m = mats[k];
+      TCALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, 1e-3));
+    }
+    assert_int_equal(sim->stress_bad, INT_MAX);
+    memcpy(got_be[s], p->be, sizeof be0);
+    memcpy(got_s[s], p->stress, sizeof(double) * 6 * NP);
+    const int exact = s < 2; /* no contraction in baseline and AVX2 */
+    for (int q = 0; q < NP; ++q) {
+      /* round-off in b and ln J reaches the stress times the moduli (tau ~ lambda ln J with
+       * ln J ~ 1e-6 here: a relative error of 1e-10 in the stress is one ulp of J) */
+      const mpmc_material *mq = &sim->mats[p->mat[q]];
+      const double tol = 1e-14 * (mq->lambda + 2.0 * mq->G);
+      for (int k = 0; k < 6; ++k) {
+        const double db = fabs(got_be[s][6 * q + k] - want_be[6 * q + k]);
+        const double ds = fabs(got_s[s][6 * q + k] - want_s[6 * q + k]);
+        if (exact ? db != 0.0 || ds != 0.0 : !(db <= 1e-14) || !(ds <= tol))
+          fail_msg("dim %d, set %d, point %d (material %d): b[%d] %.17g (want %.17g), stress[%d] "
+                   "%.17g (want %.17g)",
+                   dim, sets[s], q, p->mat[q], k, got_be[s][6 * q + k], want_be[6 * q + k], k,
+                   got_s[s][6 * q + k], want_s[6 * q + k]);
+      }
+    }
+  }
+  if (ran[2] && ran[3] &&
+      (memcmp(got_be[2], got_be[3], sizeof be0) || memcmp(got_s[2], got_s[3], sizeof be0)))
+    fail_msg("dim %d: FMA and AVX512 Neo-Hookean updates differ", dim);
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+  test_ctx = NULL;
+}
+
+static void test_batch_equals_formula(void **state) {
+  (void)state;
+  run_dim(3);
+  run_dim(2);
+}
+
+/* E = 1e304, nu = 0.49999 (lambda = 1.7e308), dF = 0.9 I at points 37 and 80, the rest I:
+ * their normal stresses, -7e307 each, add up to -inf (mpmc_stress_finite).  mixed: point 38
+ * of a second Neo-Hookean material, so that 37's block goes point by point.  Neo-Hookean
+ * materials alone, so that the update's own guard is the step's (no pass over the stresses
+ * after it: stress_update.c). */
+static void guard(int mixed) {
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  mpmc_sim sim = test_unit_box_sim(ctx, 3);
+  int m, h, mat[NP];
+  TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e304, 0.49999, 2000, &m));
+  TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e7, 0.3, 2000, &h));
+  for (int q = 0; q < NP; ++q) mat[q] = mixed && q == 38 ? h : m;
+  test_points_on_line(sim, NP, mat);
+  TCALL(mpmc_sim_prepare(sim));
+  mpmc_particles *p = &sim->p;
+  for (int q = 0; q < NP; ++q)
+    for (int k = 0; k < 9; ++k) p->dF[q * 9 + k] = k % 4 ? 0.0 : (q == 37 || q == 80 ? 0.9 : 1.0);
+  const int e = mpmc_stress_update(sim, 1e-3);
+  if (e != MPMC_ERR_NUMERIC || !strstr(mpmc_context_last_error(ctx), "point 37 at") ||
+      !strstr(mpmc_context_last_error(ctx), "non-finite stress"))
+    fail_msg("%s: code %d, '%s'", mixed ? "mixed block" : "block of four", e,
+             mpmc_context_last_error(ctx));
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+  test_ctx = NULL;
+}
+
+static void test_stress_guard(void **state) {
+  (void)state;
+  guard(0);
+  guard(1);
+}
+
+int main(void) {
+  const struct CMUnitTest tests[] = {cmocka_unit_test(test_batch_equals_formula),
+                                     cmocka_unit_test(test_stress_guard)};
+  return cmocka_run_group_tests(tests, NULL, NULL);
+}
