@@ -1,6 +1,6 @@
 /* Blocks of four points in vectors of four doubles, lanes the points (points 4k .. 4k + 3):
  * the loads and stores between the points' rows and such vectors, and the arithmetic that
- * the batched stress updates share (stress_j2.c, stress_elastic.c; kernel files, compiled
+ * the batched stress updates share (stress_j2.c, stress_blocks.c; kernel files, compiled
  * once per instruction set: mpmc_impl.h, MPMC_ISA). */
 #ifndef MPMC_BATCH4_H
 #define MPMC_BATCH4_H

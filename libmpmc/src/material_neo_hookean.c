@@ -5,10 +5,9 @@
 
 #include "mpmc_impl.h"
 
-/* in the sim's instruction set, four points at a time (stress_elastic.c) */
+/* in the sim's instruction set, four points at a time (stress_blocks.c) */
 static int nh_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) {
-  (void)dt;
-  return mpmc_kernels_nh_batch(sim)(sim, mat, id);
+  return mpmc_kernels_stress_batch(sim, MPMC_MAT_NEO_HOOKEAN)(sim, mat, id, dt);
 }
 
 static double nh_wave_speed(const mpmc_material *m) {

@@ -368,7 +368,7 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
 }
 
 /* The step's kernel phases (p2g.c, grid_update.c, g2p.c, fbar.c; stress_j2.c and
- * stress_elastic.c, the Hencky-J2 and Neo-Hookean updates) exist once per
+ * stress_blocks.c, the Hencky-J2, Neo-Hookean and Newtonian updates) exist once per
  * instruction set: CMakeLists.txt compiles these files three times more, for x86-64-v3 (AVX2)
  * with MPMC_ISA_AVX2 defined, which appends _avx2 to their external names, with MPMC_ISA_FMA
  * (_fma) and fused multiply-adds allowed, and as fma for x86-64-v4 (AVX-512) with
@@ -393,7 +393,8 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
   int mpmc_g2p##S(struct mpmc_sim_s *sim, double dt);          \
   int mpmc_fbar##S(struct mpmc_sim_s *sim, int defer);         \
   void mpmc_fbar_gather_range##S(struct mpmc_sim_s *sim, int id, int q0, int q1, double *scale); \
-  int mpmc_nh_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id);
+  int mpmc_nh_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt); \
+  int mpmc_newtonian_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt);
 /* phases of one step (step.c calls them in this order, mpmc_stress_update last) */
 MPMC_KERNEL_PROTOTYPES()
 #if defined(MPMC_HAVE_AVX2_KERNELS) || defined(MPMC_ISA_AVX2) || defined(MPMC_ISA_FMA)
@@ -402,10 +403,12 @@ MPMC_KERNEL_PROTOTYPES(_fma)
 MPMC_KERNEL_PROTOTYPES(_avx512)
 #endif
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
-/* the sim's set of mpmc_nh_batch (stress_elastic.c: the Neo-Hookean update), which
- * material_neo_hookean.c runs */
-typedef int (*mpmc_nh_batch_fn)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id);
-mpmc_nh_batch_fn mpmc_kernels_nh_batch(const struct mpmc_sim_s *sim);
+/* the sim's set of a material's update over blocks of four (stress_blocks.c), which the
+ * material's ops->stress_update runs: model MPMC_MAT_NEO_HOOKEAN (mpmc_nh_batch) or
+ * MPMC_MAT_NEWTONIAN (mpmc_newtonian_batch) */
+typedef int (*mpmc_stress_batch_fn)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
+                                    double dt);
+mpmc_stress_batch_fn mpmc_kernels_stress_batch(const struct mpmc_sim_s *sim, int model);
 /* the step's stress guard (stress_update.c): 0 if a component of s (Voigt) is NaN or Inf */
 static inline int mpmc_stress_finite(const double *s) {
   return isfinite(s[0] + s[1] + s[2] + s[3] + s[4] + s[5]);

@@ -1,11 +1,13 @@
-/* The Neo-Hookean stress update over blocks of four points (stress_elastic.c) against the
- * formula point by point (b <- dF b dF^T, tau = mu (b - 1) + lambda ln J 1, sigma = tau / J,
- * with linalg.h's push-forward and determinant): 2D and 3D, a point count that leaves a
- * partial last block, two Neo-Hookean materials and a Hencky one interleaved (blocks that mix
- * materials go point by point), b from near I to stretches of 1.5; the baseline and AVX2 sets
- * give the formula's bits, the FMA and AVX512 sets agree to round-off (and with each other,
- * bit for bit); the update keeps the step's guard: a point whose stress overflows stops it
- * with MPMC_ERR_NUMERIC naming that point, from a block of four and from a mixed block. */
+/* The Neo-Hookean and Newtonian stress updates over blocks of four points (stress_blocks.c)
+ * against their formulas point by point (Neo-Hookean: b <- dF b dF^T, tau = mu (b - 1) +
+ * lambda ln J 1, sigma = tau / J, with linalg.h's push-forward and determinant; Newtonian:
+ * sigma = K (J - 1) 1 + 2 mu dev(sym(dF - 1) / dt)): 2D and 3D, a point count that leaves a
+ * partial last block, two Neo-Hookean materials, a fluid and a Hencky one interleaved (blocks
+ * that mix materials go point by point), b from near I to stretches of 1.5; the baseline and
+ * AVX2 sets give the formulas' bits, the FMA and AVX512 sets agree to round-off (and with each
+ * other, bit for bit); each update keeps the step's guard: a point whose stress overflows
+ * stops it with MPMC_ERR_NUMERIC naming that point, from a block of four and from a mixed
+ * block. */
 #include <limits.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -22,29 +24,38 @@
 #include "test_rand.h"
 
 #define NP 103
+#define DT 1e-3 /* the step the updates get (the fluid's rate of deformation) */
 
 static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
   mpmc_sim sim = test_unit_box_sim(ctx, dim);
   TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e6, 0.45, 2000, &mats[0]));
   TCALL(mpmc_sim_add_material_neo_hookean(sim, 70, 0.499, 1, &mats[1]));
   TCALL(mpmc_sim_add_material_hencky(sim, 1e7, 0.3, 2000, &mats[2]));
+  TCALL(mpmc_sim_add_material_newtonian(sim, 2e6, 1e-3, 1000, &mats[3]));
   int mat[NP];
-  for (int q = 0; q < NP; ++q) /* the first 40 points all of material A (whole blocks), then
-                                  B every third point and Hencky every seventh: mixed blocks */
-    mat[q] = q < 40 ? mats[0] : q % 7 == 3 ? mats[2] : q % 3 == 1 ? mats[1] : mats[0];
+  for (int q = 0; q < NP; ++q) /* the first 40 points of material A, the next 12 fluid (whole
+                                  blocks), then B every third point, Hencky every seventh and
+                                  fluid every fifth: mixed blocks */
+    mat[q] = q < 40   ? mats[0]
+             : q < 52 ? mats[3]
+             : q % 7 == 3 ? mats[2]
+             : q % 5 == 0 ? mats[3]
+             : q % 3 == 1 ? mats[1]
+                          : mats[0];
   test_points_on_line(sim, NP, mat);
   TCALL(mpmc_sim_prepare(sim));
   return sim;
 }
 
 /* random inputs: b SPD with stretches up to 1.5 (b_zz too in 2D: the formula takes any b),
- * dF of strain magnitudes 1e-9 .. 0.05 */
+ * dF of strain magnitudes 1e-9 .. 0.05, J within 1 % of 1 */
 static void fill(mpmc_sim sim) {
   mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   for (int q = 0; q < NP; ++q) {
     rand_spd(d, q % 5 == 2 ? 0.4 : q % 2 ? 1e-6 : 0.02, p->be + q * 6);
     rand_dF(d, loguni(1e-9, 0.05), p->dF + q * d * d);
+    p->J[q] = 1.0 + 0.01 * (2.0 * urand() - 1.0); /* the fluid's */
     for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
   }
 }
@@ -53,7 +64,7 @@ static void run_dim(int dim) {
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
-  int mats[3];
+  int mats[4];
   mpmc_sim sim = make(ctx, dim, mats);
   mpmc_particles *p = &sim->p;
   fill(sim);
@@ -66,8 +77,20 @@ static void run_dim(int dim) {
     double *b = want_be + 6 * q, *s = want_s + 6 * q;
     memcpy(b, be0 + 6 * q, sizeof(double) * 6);
     for (int k = 0; k < 6; ++k) s[k] = 0.0;
-    if (p->mat[q] == mats[2]) continue; /* Hencky: not this update's */
+    if (p->mat[q] == mats[2]) continue; /* Hencky: not these updates' */
     const mpmc_material *m = &sim->mats[p->mat[q]];
+    if (p->mat[q] == mats[3]) { /* material_newtonian.c's formula, J (F-bar is off) */
+      const double *f = dF0 + q * dim * dim, inv_dt = 1.0 / DT;
+      double D[3][3] = {{0}};
+      for (int a = 0; a < dim; ++a)
+        for (int c = 0; c < dim; ++c) D[a][c] = 0.5 * (f[a * dim + c] + f[c * dim + a]) * inv_dt;
+      for (int a = 0; a < dim; ++a) D[a][a] -= inv_dt;
+      const double trD = (D[0][0] + D[1][1] + D[2][2]) / 3.0, pr = m->K * (p->J[q] - 1.0);
+      const double mu2 = 2.0 * m->mu;
+      for (int a = 0; a < 3; ++a) s[a] = pr + mu2 * (D[a][a] - trD);
+      s[3] = mu2 * D[1][2], s[4] = mu2 * D[0][2], s[5] = mu2 * D[0][1];
+      continue;
+    }
     double F[3][3];
     mpmc_embed(dim, dF0 + q * dim * dim, F);
     mpmc_push_forward(F, b);
@@ -88,9 +111,9 @@ static void run_dim(int dim) {
     memcpy(p->dF, dF0, sizeof(double) * NP * dim * dim);
     for (int k = 0; k < 6 * NP; ++k) p->stress[k] = 0.0;
     sim->stress_bad = INT_MAX;
-    for (int k = 0; k < 2; ++k) {
+    for (int k = 0; k < 4; ++k) {
       const int m = mats[k];
-      TCALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, 1e-3));
+      if (k != 2) TCALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, DT));
     }
     assert_int_equal(sim->stress_bad, INT_MAX);
     memcpy(got_be[s], p->be, sizeof be0);
@@ -100,7 +123,7 @@ static void run_dim(int dim) {
       /* round-off in b and ln J reaches the stress times the moduli (tau ~ lambda ln J with
        * ln J ~ 1e-6 here: a relative error of 1e-10 in the stress is one ulp of J) */
       const mpmc_material *mq = &sim->mats[p->mat[q]];
-      const double tol = 1e-14 * (mq->lambda + 2.0 * mq->G);
+      const double tol = 1e-14 * (p->mat[q] == mats[3] ? mq->K + mq->mu / DT : mq->lambda + 2.0 * mq->G);
       for (int k = 0; k < 6; ++k) {
         const double db = fabs(got_be[s][6 * q + k] - want_be[6 * q + k]);
         const double ds = fabs(got_s[s][6 * q + k] - want_s[6 * q + k]);
@@ -114,7 +137,7 @@ static void run_dim(int dim) {
   }
   if (ran[2] && ran[3] &&
       (memcmp(got_be[2], got_be[3], sizeof be0) || memcmp(got_s[2], got_s[3], sizeof be0)))
-    fail_msg("dim %d: FMA and AVX512 Neo-Hookean updates differ", dim);
+    fail_msg("dim %d: FMA and AVX512 updates differ", dim);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;
@@ -126,30 +149,39 @@ static void test_batch_equals_formula(void **state) {
   run_dim(2);
 }
 
-/* E = 1e304, nu = 0.49999 (lambda = 1.7e308), dF = 0.9 I at points 37 and 80, the rest I:
- * their normal stresses, -7e307 each, add up to -inf (mpmc_stress_finite).  mixed: point 38
- * of a second Neo-Hookean material, so that 37's block goes point by point.  Neo-Hookean
- * materials alone, so that the update's own guard is the step's (no pass over the stresses
- * after it: stress_update.c). */
-static void guard(int mixed) {
+/* Points 37 and 80 overflow, the rest I: fluid = 0, Neo-Hookean with E = 1e304, nu = 0.49999
+ * (lambda = 1.7e308) and dF = 0.9 I, whose normal stresses, -7e307 each, add up to -inf
+ * (mpmc_stress_finite); fluid = 1, the fluid with K = 1e300 and J = 1e10 there.  mixed: point
+ * 38 of a second material of the same model, so that 37's block goes point by point.  One
+ * model alone, so that the update's own guard is the step's (no pass over the stresses after
+ * it: stress_update.c). */
+static void guard(int fluid, int mixed) {
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
   mpmc_sim sim = test_unit_box_sim(ctx, 3);
   int m, h, mat[NP];
-  TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e304, 0.49999, 2000, &m));
-  TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e7, 0.3, 2000, &h));
+  if (fluid) {
+    TCALL(mpmc_sim_add_material_newtonian(sim, 1e300, 1e-3, 1000, &m));
+    TCALL(mpmc_sim_add_material_newtonian(sim, 2e6, 1e-3, 1000, &h));
+  } else {
+    TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e304, 0.49999, 2000, &m));
+    TCALL(mpmc_sim_add_material_neo_hookean(sim, 1e7, 0.3, 2000, &h));
+  }
   for (int q = 0; q < NP; ++q) mat[q] = mixed && q == 38 ? h : m;
   test_points_on_line(sim, NP, mat);
   TCALL(mpmc_sim_prepare(sim));
   mpmc_particles *p = &sim->p;
-  for (int q = 0; q < NP; ++q)
-    for (int k = 0; k < 9; ++k) p->dF[q * 9 + k] = k % 4 ? 0.0 : (q == 37 || q == 80 ? 0.9 : 1.0);
-  const int e = mpmc_stress_update(sim, 1e-3);
+  for (int q = 0; q < NP; ++q) {
+    const int bad = q == 37 || q == 80;
+    for (int k = 0; k < 9; ++k) p->dF[q * 9 + k] = k % 4 ? 0.0 : (bad && !fluid ? 0.9 : 1.0);
+    p->J[q] = bad && fluid ? 1e10 : 1.0;
+  }
+  const int e = mpmc_stress_update(sim, DT);
   if (e != MPMC_ERR_NUMERIC || !strstr(mpmc_context_last_error(ctx), "point 37 at") ||
       !strstr(mpmc_context_last_error(ctx), "non-finite stress"))
-    fail_msg("%s: code %d, '%s'", mixed ? "mixed block" : "block of four", e,
-             mpmc_context_last_error(ctx));
+    fail_msg("%s, %s: code %d, '%s'", fluid ? "fluid" : "Neo-Hookean",
+             mixed ? "mixed block" : "block of four", e, mpmc_context_last_error(ctx));
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;
@@ -157,8 +189,8 @@ static void guard(int mixed) {
 
 static void test_stress_guard(void **state) {
   (void)state;
-  guard(0);
-  guard(1);
+  for (int fluid = 0; fluid < 2; ++fluid)
+    for (int mixed = 0; mixed < 2; ++mixed) guard(fluid, mixed);
 }
 
 int main(void) {

@@ -1,0 +1,161 @@
+/* The Neo-Hookean and the Newtonian stress updates (material_neo_hookean.c,
+ * material_newtonian.c) over blocks of four points, one of the kernel files compiled once per
+ * instruction set (mpmc_impl.h, MPMC_ISA):
+ *   Neo-Hookean  b <- dF b dF^T,  J = sqrt(det b),  tau = mu (b - 1) + lambda ln J 1,
+ *                sigma = tau / J  (plane strain: b_zz stays 1, dF embedded in 3 x 3);
+ *   Newtonian    sigma = K (J - 1) 1 + 2 mu dev(D),  D = sym(dF - 1) / dt, J the F-bar
+ *                Jacobian when F-bar is on (formulas.md).
+ * Four points of the material in a row (points 4k .. 4k + 3) go through them as vectors of
+ * four doubles, lanes the points, with the operations of the point-by-point form in the same
+ * order (batch4.h), so the same bits as one point alone in a set without contraction
+ * (baseline, avx2: tests/t303, t413); ln J stays libm's log per lane.  A block that holds
+ * another material's points or the end of the arrays goes point by point.  The blocks are
+ * fixed by the index, so the results do not depend on the thread count.  The updates keep the
+ * stress guard themselves (ops->checks_stress: the lowest non-finite point into
+ * sim->stress_bad, a pass over the stresses less). */
+#include <limits.h>
+#include <math.h>
+
+#include "batch4.h"
+#include "linalg.h"
+#include "mpmc_impl.h"
+
+/* the lowest point of the block q0 .. q0 + 3 whose stress s (lanes) is not finite
+ * (mpmc_stress_finite's sum per lane), or INT_MAX */
+static inline int block_guard(const v4 *s, int q0) {
+  const v4 sum = s[0] + s[1] + s[2] + s[3] + s[4] + s[5], nf = sum - sum; /* 0 if finite */
+  for (int l = 0; l < 4; ++l)
+    if (!(nf[l] == 0.0)) return q0 + l;
+  return INT_MAX;
+}
+
+/* The loop of both updates over material id's points: BLOCK (an expression of q0, the lowest
+ * non-finite point of the block or INT_MAX) for four of them in a row, else POINT (of q, 0 if
+ * its stress is not finite) one by one; the lowest non-finite point into sim->stress_bad.  A
+ * macro, for the OpenMP region to see BLOCK and POINT inlined (transfer.h, MPMC_KERNELS). */
+#define MPMC_BLOCKS(sim, id, BLOCK, POINT)                                                   \
+  do {                                                                                       \
+    const int n_ = (sim)->p.n, nblk_ = (n_ + 3) / 4, *restrict m_ = (sim)->p.mat;            \
+    int first_nf_ = INT_MAX;                                                                 \
+    _Pragma("omp parallel for schedule(static) reduction(min : first_nf_) if (n_ > MPMC_OMP_MIN)") \
+    for (int blk_ = 0; blk_ < nblk_; ++blk_) {                                               \
+      const int q0 = 4 * blk_;                                                               \
+      if (q0 + 3 < n_ && m_[q0] == (id) && m_[q0 + 1] == (id) && m_[q0 + 2] == (id) &&       \
+          m_[q0 + 3] == (id)) {                                                              \
+        const int bad_ = (BLOCK);                                                            \
+        first_nf_ = bad_ < first_nf_ ? bad_ : first_nf_;                                     \
+      } else {                                                                               \
+        for (int q = q0; q < q0 + 4 && q < n_; ++q)                                          \
+          if (m_[q] == (id) && !(POINT) && q < first_nf_) first_nf_ = q;                     \
+      }                                                                                      \
+    }                                                                                        \
+    if (first_nf_ < (sim)->stress_bad) (sim)->stress_bad = first_nf_; /* stress_update.c */  \
+  } while (0)
+
+/* ---- Neo-Hookean ---------------------------------------------------------------------- */
+
+/* point q alone; returns 0 if its stress is not finite */
+static inline int nh_point(mpmc_particles *p, const int d, double mu, double lam, int q) {
+  double F[3][3];
+  mpmc_embed(d, p->dF + (size_t)q * d * d, F);
+  double *b = p->be + (size_t)q * 6;
+  mpmc_push_forward(F, b);
+  const double J = sqrt(mpmc_det_sym(b));
+  const double lnJ = log(J), inv_J = 1.0 / J;
+  double *s = p->stress + (size_t)q * 6;
+  for (int k = 0; k < 6; ++k) {
+    const double tau = mu * (b[k] - (k < 3)) + (k < 3 ? lam * lnJ : 0.0);
+    s[k] = tau * inv_J;
+  }
+  return mpmc_stress_finite(s);
+}
+
+/* the four points q0 .. q0 + 3, all of the material, as vectors: nh_point's operations;
+ * returns block_guard's point */
+static inline int nh_block(mpmc_particles *p, const int d, double mu, double lam, int q0) {
+  const v4 one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
+  v4 F[9], b[6], bt[6], s[6];
+  load_dF4(d, p->dF + (size_t)q0 * d * d, &one, F);
+  double *be = p->be + (size_t)q0 * 6;
+  load_rows6(be, b);
+  push_forward4(F, b, bt);
+  /* mpmc_det_sym's order */
+  const v4 det = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
+                 bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
+  v4 J;
+  sqrt4(&det, &J);
+  const v4 lnJ = {log(J[0]), log(J[1]), log(J[2]), log(J[3])}, inv_J = 1.0 / J;
+  for (int k = 0; k < 6; ++k)
+    s[k] = (mu * (bt[k] - (k < 3 ? one : zero)) + (k < 3 ? lam * lnJ : zero)) * inv_J;
+  store_rows6(bt, be);
+  store_rows6(s, p->stress + (size_t)q0 * 6);
+  return block_guard(s, q0);
+}
+
+/** The stress update of material id's points (Neo-Hookean: mat->G, mat->lambda). */
+int MPMC_ISA(mpmc_nh_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
+  (void)dt;
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  const double mu = mat->G, lam = mat->lambda;
+  MPMC_BLOCKS(sim, id, nh_block(p, d, mu, lam, q0), nh_point(p, d, mu, lam, q));
+  return MPMC_SUCCESS;
+}
+
+/* ---- Newtonian fluid ------------------------------------------------------------------ */
+
+/* s = pr 1 + mu2 dev D (trD = tr D / 3), Voigt, for scalars and vectors alike */
+#define NEWTONIAN_STRESS(s, pr, mu2, D, trD)            \
+  do {                                                  \
+    (s)[0] = (pr) + (mu2) * ((D)[0][0] - (trD));        \
+    (s)[1] = (pr) + (mu2) * ((D)[1][1] - (trD));        \
+    (s)[2] = (pr) + (mu2) * ((D)[2][2] - (trD));        \
+    (s)[3] = (mu2) * (D)[1][2];                         \
+    (s)[4] = (mu2) * (D)[0][2];                         \
+    (s)[5] = (mu2) * (D)[0][1];                         \
+  } while (0)
+
+/* point q alone (Jm: J or Jbar); returns 0 if its stress is not finite */
+static inline int newtonian_point(mpmc_particles *p, const int d, double K, double mu2,
+                                  double inv_dt, const double *Jm, int q) {
+  const double *f = p->dF + (size_t)q * d * d;
+  double D[3][3] = {{0}};
+  for (int a = 0; a < d; ++a)
+    for (int b = 0; b < d; ++b) D[a][b] = 0.5 * (f[a * d + b] + f[b * d + a]) * inv_dt;
+  for (int a = 0; a < d; ++a) D[a][a] -= inv_dt;
+  const double trD = (D[0][0] + D[1][1] + D[2][2]) / 3.0;
+  const double pr = K * (Jm[q] - 1.0);
+  double *s = p->stress + (size_t)q * 6;
+  NEWTONIAN_STRESS(s, pr, mu2, D, trD);
+  return mpmc_stress_finite(s);
+}
+
+/* the four points q0 .. q0 + 3 as vectors: newtonian_point's operations; returns
+ * block_guard's point */
+static inline int newtonian_block(mpmc_particles *p, const int d, double K, double mu2,
+                                  double inv_dt, const double *Jm, int q0) {
+  const v4 one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
+  v4 F[9], D[3][3], s[6];
+  load_dF4(d, p->dF + (size_t)q0 * d * d, &one, F);
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      D[a][b] = a < d && b < d ? 0.5 * (F[3 * a + b] + F[3 * b + a]) * inv_dt : zero;
+  for (int a = 0; a < d; ++a) D[a][a] -= inv_dt;
+  const v4 trD = (D[0][0] + D[1][1] + D[2][2]) / 3.0;
+  const v4 pr = K * ((v4) * (const v4u *)(Jm + q0) - 1.0);
+  NEWTONIAN_STRESS(s, pr, mu2, D, trD);
+  store_rows6(s, p->stress + (size_t)q0 * 6);
+  return block_guard(s, q0);
+}
+
+/** The stress update of material id's points (Newtonian fluid: mat->K, mat->mu). */
+int MPMC_ISA(mpmc_newtonian_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
+                                   double dt) {
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  const double K = mat->K, mu2 = 2.0 * mat->mu, inv_dt = dt > 0 ? 1.0 / dt : 0.0;
+  const double *Jm = sim->fbar ? p->Jbar : p->J;
+  MPMC_BLOCKS(sim, id, newtonian_block(p, d, K, mu2, inv_dt, Jm, q0),
+              newtonian_point(p, d, K, mu2, inv_dt, Jm, q));
+  return MPMC_SUCCESS;
+}
