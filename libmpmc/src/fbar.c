@@ -251,23 +251,60 @@ MPMC_ALWAYS_INLINE double gather_stable_scale(mpmc_sim sim, const int DIM, const
   return projection_scale(p, DIM, q, pi, inv);
 }
 
+/* gather_stable_scale for the four points q .. q + 3 (positions xs) into scale[0..3], each
+ * lane with the same operations as one point alone (same bits): the weights of the four at
+ * once, the sum over each lane's nodes in MPMC_STABLE_LOOP's order, the finish as a vector */
+MPMC_ALWAYS_INLINE void gather_stable_scale4(mpmc_sim sim, const int DIM, const int BASIS,
+                                             const double *xs, int q, double *scale) {
+  const mpmc_grid *g = &sim->grid;
+  mpmc_particles *p = &sim->p;
+  const double *restrict jb = g->fbj;
+  const int S = mpmc_stable_stencil(BASIS), idx[4] = {q, q + 1, q + 2, q + 3};
+  const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
+  mpmc_spw4 sp;
+  mpmc_stable_weights4(DIM, BASIS, g, xs, idx, &sp);
+  const mpmc_b4da *w0 = (const mpmc_b4da *)sp.w[0], *w1 = (const mpmc_b4da *)sp.w[1],
+                  *w2 = (const mpmc_b4da *)sp.w[2];
+  const mpmc_b4d one = {1.0, 1.0, 1.0, 1.0};
+  mpmc_b4d pi = {0.0, 0.0, 0.0, 0.0};
+  for (int k = 0; k < (DIM == 3 ? S : 1); ++k)
+    for (int j = 0; j < S; ++j) {
+      const size_t r = sp.st[1] * (size_t)j + sp.st[2] * (size_t)k;
+      const mpmc_b4d wr = w1[j] * (DIM == 3 ? (mpmc_b4d)w2[k] : one);
+      for (int i = 0; i < S; ++i) {
+        const size_t o = r + sp.st[0] * (size_t)i;
+        const mpmc_b4d v = {jb[(size_t)sp.node0[0] + o], jb[(size_t)sp.node0[1] + o],
+                            jb[(size_t)sp.node0[2] + o], jb[(size_t)sp.node0[3] + o]};
+        pi += (w0[i] * wr) * v;
+      }
+    }
+  gather_finish4(p, DIM, q, &pi, &inv, scale);
+}
+
 /* dF-bar = scale dF of point q, in place */
 MPMC_ALWAYS_INLINE void scale_dF(mpmc_particles *p, const int DIM, int q, double scale) {
   double *dF = p->dF + (size_t)q * DIM * DIM;
   for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
 }
 
+/* one point's factor in either form (ST: the stable one) */
+MPMC_ALWAYS_INLINE double gather_scale1(mpmc_sim sim, const int D, const int B, const int ST,
+                                        const double *xs, int q) {
+  return ST ? gather_stable_scale(sim, D, B, xs, q) : gather_scale(sim, D, B, xs, q);
+}
+
 /* The gather's factors of points q0 .. q1 - 1 at positions xs (Algorithm 1, step 4) into
- * scale[q - q0], in the paper and total forms: of material id's points (id < 0: of every
- * point; the others' entries and Jbar left alone).  Eight points at a time where they are all
- * gathered, else four, then one by one: each lane with the operations of gather_scale, so the
- * same bits as point by point. */
-MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, const double *xs,
-                                      int id, int q0, int q1, double *scale) {
+ * scale[q - q0]: of material id's points (id < 0: of every point; the others' entries and
+ * Jbar left alone).  The paper and total forms eight points at a time where they are all
+ * gathered, else four, then one by one, each lane with the operations of gather_scale; the
+ * stable form (ST) four at a time, else one by one (gather_stable_scale): the same bits as
+ * point by point. */
+MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, const int ST,
+                                      const double *xs, int id, int q0, int q1, double *scale) {
   const int *restrict mat = sim->p.mat;
   const int one = id < 0 || sim->nmat == 1; /* every point is gathered */
   int q = q0;
-  for (; one && q + 8 <= q1; q += 8) {
+  for (; !ST && one && q + 8 <= q1; q += 8) {
     const int idx[8] = {q, q + 1, q + 2, q + 3, q + 4, q + 5, q + 6, q + 7};
     mpmc_pw4 t[2]; /* the same bits as mpmc_point_weights1 per point */
     mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t[0]);
@@ -277,22 +314,42 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
   for (; q + 4 <= q1; q += 4) {
     if (!one && mat[q] != id && mat[q + 1] != id && mat[q + 2] != id && mat[q + 3] != id)
       continue;
-    const int idx[4] = {q, q + 1, q + 2, q + 3};
-    mpmc_pw4 t; /* the same bits as mpmc_point_weights1 per point */
-    mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t);
-    if (one || (mat[q] == id && mat[q + 1] == id && mat[q + 2] == id && mat[q + 3] == id))
-      gather_scale4(sim, D, B, &t, q, scale + (q - q0));
-    else /* materials mixed: the others' scale and Jbar left alone */
+    if (one || (mat[q] == id && mat[q + 1] == id && mat[q + 2] == id && mat[q + 3] == id)) {
+      if (ST) {
+        gather_stable_scale4(sim, D, B, xs, q, scale + (q - q0));
+      } else {
+        const int idx[4] = {q, q + 1, q + 2, q + 3};
+        mpmc_pw4 t; /* the same bits as mpmc_point_weights1 per point */
+        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t);
+        gather_scale4(sim, D, B, &t, q, scale + (q - q0));
+      }
+    } else { /* materials mixed: the others' scale and Jbar left alone */
       for (int l = 0; l < 4; ++l)
-        if (mat[q + l] == id) scale[q + l - q0] = gather_scale(sim, D, B, xs, q + l);
+        if (mat[q + l] == id) scale[q + l - q0] = gather_scale1(sim, D, B, ST, xs, q + l);
+    }
   }
   for (; q < q1; ++q)
-    if (one || mat[q] == id) scale[q - q0] = gather_scale(sim, D, B, xs, q);
+    if (one || mat[q] == id) scale[q - q0] = gather_scale1(sim, D, B, ST, xs, q);
 }
 
 /* points the gather of the fbar phase takes at a time (the deferred one goes by the J2
  * update's chunks: stress_j2.c) */
 #define GATHER_CHUNK 256
+
+/* The F-bar phase's gather (ST: the stable form's): every point's, GATHER_CHUNK at a time,
+ * its dF scaled in place (x^n still in x); in the kernels' macro, so that ST reaches the
+ * OpenMP region as a constant (transfer.h, MPMC_KERNELS) */
+#define GATHER_CHUNKS(D, B, ST)                                                              \
+  do {                                                                                       \
+    const int n = sim->p.n, nch = (n + GATHER_CHUNK - 1) / GATHER_CHUNK;                     \
+    _Pragma("omp parallel for schedule(static) if (n > MPMC_OMP_MIN)")                       \
+    for (int ch = 0; ch < nch; ++ch) {                                                       \
+      const int q0 = ch * GATHER_CHUNK, q1 = q0 + GATHER_CHUNK < n ? q0 + GATHER_CHUNK : n;  \
+      double scale[GATHER_CHUNK];                                                            \
+      gather_points(sim, D, B, ST, sim->p.x, -1, q0, q1, scale);                             \
+      for (int q = q0; q < q1; ++q) scale_dF(&sim->p, D, q, scale[q - q0]);                  \
+    }                                                                                        \
+  } while (0)
 
 /* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
 #define FBAR_KERNELS(D, B)                                                                   \
@@ -304,27 +361,14 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
         for (int k = start[sl]; k < start[sl + 1]; ++k) scatter_point(sim, D, B, order[k]);  \
     }                                                                                        \
   }                                                                                          \
-  /* every point's, GATHER_CHUNK at a time, its dF scaled in place (x^n still in x) */      \
-  static void gather_##D##_##B(mpmc_sim sim) {                                               \
-    const int n = sim->p.n, nch = (n + GATHER_CHUNK - 1) / GATHER_CHUNK;                     \
-    _Pragma("omp parallel for schedule(static) if (n > MPMC_OMP_MIN)")                       \
-    for (int ch = 0; ch < nch; ++ch) {                                                       \
-      const int q0 = ch * GATHER_CHUNK, q1 = q0 + GATHER_CHUNK < n ? q0 + GATHER_CHUNK : n;  \
-      double scale[GATHER_CHUNK];                                                            \
-      gather_points(sim, D, B, sim->p.x, -1, q0, q1, scale);                                 \
-      for (int q = q0; q < q1; ++q) scale_dF(&sim->p, D, q, scale[q - q0]);                  \
-    }                                                                                        \
-  }                                                                                          \
+  static void gather_##D##_##B(mpmc_sim sim) { GATHER_CHUNKS(D, B, 0); }                     \
+  static void gather_stable_##D##_##B(mpmc_sim sim) { GATHER_CHUNKS(D, B, 1); }              \
   /* the deferred gather of points q0 .. q1 - 1 of material id (x^n in xn by then) */        \
   static void gather_range_##D##_##B(mpmc_sim sim, int id, int q0, int q1, double *scale) {  \
-    const int *restrict mat = sim->p.mat;                                                    \
-    const double *xs = sim->p.xn;                                                            \
-    if (sim->fbar == MPMC_FBAR_STABLE) {                                                     \
-      for (int q = q0; q < q1; ++q)                                                          \
-        if (mat[q] == id) scale[q - q0] = gather_stable_scale(sim, D, B, xs, q);             \
-    } else {                                                                                 \
-      gather_points(sim, D, B, xs, id, q0, q1, scale);                                       \
-    }                                                                                        \
+    if (sim->fbar == MPMC_FBAR_STABLE)                                                       \
+      gather_points(sim, D, B, 1, sim->p.xn, id, q0, q1, scale);                             \
+    else                                                                                     \
+      gather_points(sim, D, B, 0, sim->p.xn, id, q0, q1, scale);                             \
   }                                                                                          \
   /* the stable form's supports reach no further than the cubic B-spline's (nodes c - 1 ..  \
    * c + 2 of a point in cell c): the slabs keep same-coloured ones apart all the same */    \
@@ -336,11 +380,6 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
         for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
           scatter_stable_point(sim, D, B, order[k]);                                         \
     }                                                                                        \
-  }                                                                                          \
-  static void gather_stable_##D##_##B(mpmc_sim sim) {                                        \
-    _Pragma("omp parallel for schedule(static) if (sim->p.n > MPMC_OMP_MIN)")                \
-    for (int q = 0; q < sim->p.n; ++q)                                                       \
-      scale_dF(&sim->p, D, q, gather_stable_scale(sim, D, B, sim->p.x, q));                  \
   }
 MPMC_KERNELS(FBAR_KERNELS)
 

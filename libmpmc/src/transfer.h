@@ -181,6 +181,45 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights(const int DIM, const int BASIS, cons
   sp->node0 = node0;
 }
 
+/* mpmc_stable_weights of the four points idx[0..3] at x, lanes the points: per axis one
+ * evaluation of mpmc_stable_1d's basis for the four (mpmc_poly_lanes: the same operations per
+ * lane as mpmc_basis_1d, so the same bits); w[a][k][l] the weight of lane l's k-th node along
+ * axis a, node0[l] its first node, st[a] the step in node index along axis a (the lanes'
+ * alike). */
+typedef struct {
+  double w[3][3][4] __attribute__((aligned(32)));
+  long long node0[4];
+  size_t st[3];
+} mpmc_spw4;
+MPMC_ALWAYS_INLINE void mpmc_stable_weights4(const int DIM, const int BASIS, const mpmc_grid *g,
+                                             const double *x, const int *idx, mpmc_spw4 *sp) {
+  mpmc_b4l node0 = {0, 0, 0, 0};
+  size_t str = 1;
+  sp->st[1] = sp->st[2] = 0;
+  for (int a = 0; a < DIM; ++a) {
+    const mpmc_b4d xv = {x[(size_t)idx[0] * DIM + a], x[(size_t)idx[1] * DIM + a],
+                         x[(size_t)idx[2] * DIM + a], x[(size_t)idx[3] * DIM + a]};
+    const mpmc_b4d s = (xv - g->origin[a]) * g->inv_h;
+    mpmc_b4i b;
+    int k = 1;
+    if (BASIS == MPMC_BASIS_LINEAR || BASIS == MPMC_BASIS_UGIMP) { /* mpmc_stable_1d's cases */
+      const int par = MPMC_GHOST % 2;
+      const mpmc_b4d sh = 0.5 * (s - par);
+      mpmc_poly_lanes(MPMC_BASIS_LINEAR, &sh, 1.0, &b, (mpmc_b4da *)sp->w[a], NULL);
+      b = par + 2 * b;
+      k = 2;
+    } else {
+      const mpmc_b4d sh = s - 0.5;
+      mpmc_poly_lanes(BASIS == MPMC_BASIS_BSPLINE3 ? MPMC_BASIS_BSPLINE2 : MPMC_BASIS_LINEAR, &sh,
+                      1.0, &b, (mpmc_b4da *)sp->w[a], NULL);
+    }
+    node0 += (long long)str * __builtin_convertvector(b, mpmc_b4l);
+    sp->st[a] = str * (size_t)k;
+    str *= (size_t)g->n[a];
+  }
+  memcpy(sp->node0, &node0, sizeof node0);
+}
+
 /* The support of point q in the stable space: the body sees `node` and its weight `w`. */
 #define MPMC_STABLE_LOOP(DIM, BASIS, sp, ...)                                                   \
   do {                                                                                     \
