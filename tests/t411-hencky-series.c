@@ -183,6 +183,40 @@ static void test_log_series_rejects(void **state) {
   for (int k = 0; k < 6; ++k) assert_true(eps[k] == 0.0);
 }
 
+/* ln x by the scalar series (mpmc_log_series: the Neo-Hookean ln J) against long double's
+ * log1pl of x - 1 (exact for x in [0.5, 2]): x - 1 log-uniform from 1e-14 to past the table's
+ * reach, both signs; within the reach 2 ulp of ln x; beyond it (and for x <= 0, NaN, Inf)
+ * refused */
+static void test_log_series_scalar(void **state) {
+  (void)state;
+  if (!have_long_double()) skip();
+  double worst = 0.0;
+  int used = 0, refused = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = 1.0 + sgn() * loguni(1e-14, 0.6);
+    double y;
+    if (mpmc_log_series(x, &y)) {
+      ++refused;
+      if (fabs(log(x)) < 0.35) fail_msg("x = %.17g (ln x = %g) refused", x, log(x));
+      continue;
+    }
+    ++used;
+    const ld ref = log1pl((ld)x - 1.0L);
+    const double err = (double)(fabsl((ld)y - ref) / fabsl(ref));
+    if (err > worst) worst = err;
+    if (!(err <= 2.0 * DBL_EPSILON)) fail_msg("x = %.17g: ln x %.17g, reference %.20Lg", x, y, ref);
+  }
+  if (used < 10000 || refused < 200) fail_msg("weak mix: %d by the series, %d refused", used, refused);
+  double y;
+  const double bad[5] = {0.0, -0.5, NAN, INFINITY, 2.5};
+  for (int k = 0; k < 5; ++k)
+    if (!mpmc_log_series(bad[k], &y)) fail_msg("x = %g taken by the series", bad[k]);
+  assert_int_equal(mpmc_log_series(1.0, &y), 0);
+  assert_true(y == 0.0);
+  if (getenv("T411_VERBOSE"))
+    print_message("scalar log: worst %.3g relative (%d by the series, %d refused)\n", worst, used, refused);
+}
+
 static void test_exp_series(void **state) {
   (void)state;
   if (!have_long_double()) skip();
@@ -403,6 +437,7 @@ static void test_j2_softening_vs_eig(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_log_series),         cmocka_unit_test(test_log_series_rejects),
+      cmocka_unit_test(test_log_series_scalar),
       cmocka_unit_test(test_exp_series),         cmocka_unit_test(test_hencky_material),
       cmocka_unit_test(test_j2_perfect_plasticity), cmocka_unit_test(test_j2_softening_vs_eig),
   };

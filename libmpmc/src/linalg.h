@@ -177,6 +177,21 @@ static inline int mpmc_sym3_log_series(const double *b, double *eps) {
   return 0;
 }
 
+/* ln x for x near 1 by the same series, ln x = 2 atanh s = 2 s sum_k s^(2k) / (2k+1) with
+ * s = (x - 1)/(x + 1), to the table's number of terms for s^2 (the Neo-Hookean ln J,
+ * stress_blocks.c, which sums it four points at a time).  Returns 0, or 1 when s^2 is beyond
+ * the table (|ln x| >~ 0.36) or x is not finite or <= 0: the caller takes libm's log. */
+static inline int mpmc_log_series(double x, double *lnx) {
+  const double s = (x - 1.0) / (x + 1.0), s2 = s * s;
+  if (!(s2 <= mpmc_atanh_rho2_max[10])) return 1; /* also NaN */
+  int n = 1;
+  while (s2 > mpmc_atanh_rho2_max[n]) ++n;
+  double p = mpmc_atanh_c[n - 1];
+  for (int k = n - 2; k >= 0; --k) p = p * s2 + mpmc_atanh_c[k];
+  *lnx = 2.0 * (s * p);
+  return 0;
+}
+
 /* eps = 1/2 ln b by the eigen-decomposition, for any b: the reference and the fallback of
  * mpmc_sym3_log_series.  A b that is not positive definite gives NaN (the callers' guards
  * report it). */

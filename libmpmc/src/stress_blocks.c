@@ -8,11 +8,13 @@
  * Four points of the material in a row (points 4k .. 4k + 3) go through them as vectors of
  * four doubles, lanes the points, with the operations of the point-by-point form in the same
  * order (batch4.h), so the same bits as one point alone in a set without contraction
- * (baseline, avx2: tests/t303, t413); ln J stays libm's log per lane.  A block that holds
- * another material's points or the end of the arrays goes point by point.  The blocks are
- * fixed by the index, so the results do not depend on the thread count.  The updates keep the
- * stress guard themselves (ops->checks_stress: the lowest non-finite point into
- * sim->stress_bad, a pass over the stresses less). */
+ * (baseline, avx2: tests/t303, t413), but for ln J: mpmc_log_series' sum (linalg.h, within
+ * 2 ulp), to the number of terms that the block's largest |J - 1| needs, and libm's log beyond
+ * its reach (|ln J| >~ 0.36).  A block that holds another material's points or the end of the
+ * arrays goes point by point.  The blocks are fixed by the index, so the results do not
+ * depend on the thread count.  The updates keep the stress guard themselves
+ * (ops->checks_stress: the lowest non-finite point into sim->stress_bad, a pass over the
+ * stresses less). */
 #include <limits.h>
 #include <math.h>
 
@@ -54,14 +56,35 @@ static inline int block_guard(const v4 *s, int q0) {
 
 /* ---- Neo-Hookean ---------------------------------------------------------------------- */
 
+/* ln x per lane by mpmc_log_series' sum (linalg.h) to the number of terms that the lanes'
+ * largest s^2 needs (the terms beyond a lane's own number are below its 2^-54 tolerance),
+ * libm's log in a lane beyond the series' reach */
+static inline void log_series4(const v4 *xp, v4 *lnx) {
+  const v4 x = *xp, s = (x - 1.0) / (x + 1.0), s2 = s * s;
+  double s2max = 0.0;
+  int out = 0;
+  for (int l = 0; l < 4; ++l) {
+    out |= !(s2[l] <= mpmc_atanh_rho2_max[10]) << l; /* also NaN */
+    s2max = s2[l] > s2max && !(out >> l & 1) ? s2[l] : s2max;
+  }
+  int n = 1;
+  while (s2max > mpmc_atanh_rho2_max[n]) ++n;
+  v4 p = s2 * 0.0 + mpmc_atanh_c[n - 1];
+  for (int k = n - 2; k >= 0; --k) p = p * s2 + mpmc_atanh_c[k];
+  *lnx = 2.0 * (s * p);
+  for (int l = 0; out; ++l, out >>= 1)
+    if (out & 1) (*lnx)[l] = log(x[l]);
+}
+
 /* point q alone; returns 0 if its stress is not finite */
 static inline int nh_point(mpmc_particles *p, const int d, double mu, double lam, int q) {
   double F[3][3];
   mpmc_embed(d, p->dF + (size_t)q * d * d, F);
   double *b = p->be + (size_t)q * 6;
   mpmc_push_forward(F, b);
-  const double J = sqrt(mpmc_det_sym(b));
-  const double lnJ = log(J), inv_J = 1.0 / J;
+  const double J = sqrt(mpmc_det_sym(b)), inv_J = 1.0 / J;
+  double lnJ;
+  if (mpmc_log_series(J, &lnJ)) lnJ = log(J);
   double *s = p->stress + (size_t)q * 6;
   for (int k = 0; k < 6; ++k) {
     const double tau = mu * (b[k] - (k < 3)) + (k < 3 ? lam * lnJ : 0.0);
@@ -84,7 +107,9 @@ static inline int nh_block(mpmc_particles *p, const int d, double mu, double lam
                  bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
   v4 J;
   sqrt4(&det, &J);
-  const v4 lnJ = {log(J[0]), log(J[1]), log(J[2]), log(J[3])}, inv_J = 1.0 / J;
+  v4 lnJ;
+  log_series4(&J, &lnJ);
+  const v4 inv_J = 1.0 / J;
   for (int k = 0; k < 6; ++k)
     s[k] = (mu * (bt[k] - (k < 3 ? one : zero)) + (k < 3 ? lam * lnJ : zero)) * inv_J;
   store_rows6(bt, be);
