@@ -22,6 +22,11 @@ struct mpmc_bodies_s {
   mpmc_body *b;
   int n, cap;
   double dhat, kappa; /* the caller's values; 0 = derive (docs/contact.md)          */
+  /* within one mpmc_sim_step (mpmc_contact_step): the derived values, held for its three
+   * uses (the time-step check, the forces, the crossing check), which would each sum the
+   * points' volumes again; nothing can change them in between */
+  double step_dhat, step_kappa;
+  int step_held;
 };
 
 /* Friction anchors for every point (points added since the last contact pass start at

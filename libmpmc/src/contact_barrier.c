@@ -119,6 +119,12 @@ static inline int far_from(const mpmc_body *b, int dim, const double *x, double 
  * over the materials: the barrier's time-step limit 2 sqrt(m/k) at d = dhat/2 is then
  * h/c for a point of mean size (docs/contact.md). */
 static void contact_params(const struct mpmc_sim_s *sim, double *dhat, double *kappa) {
+  const struct mpmc_bodies_s *H = sim->bodies;
+  if (H && H->step_held) { /* within a step: mpmc_contact_step's */
+    *dhat = H->step_dhat;
+    *kappa = H->step_kappa;
+    return;
+  }
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   const double h = sim->grid.h;
@@ -279,6 +285,15 @@ static double min_gap(const struct mpmc_sim_s *sim, const mpmc_body *b, int *poi
   }
   if (point) *point = qmin;
   return gmin;
+}
+
+void mpmc_contact_step(struct mpmc_sim_s *sim, int begin) {
+  struct mpmc_bodies_s *B = sim->bodies;
+  B->step_held = 0;
+  if (begin) {
+    contact_params(sim, &B->step_dhat, &B->step_kappa);
+    B->step_held = 1;
+  }
 }
 
 /* After a step: no point may have crossed into a body (the step that did it fails). */

@@ -435,6 +435,9 @@ double mpmc_contact_stable_dt(const struct mpmc_sim_s *sim);
 void mpmc_contact_free(struct mpmc_sim_s *sim);
 /* after the step: a point that crossed into a body fails the step (MPMC_ERR_NUMERIC) */
 int mpmc_contact_check(struct mpmc_sim_s *sim);
+/* begin = 1: derive the barrier's parameters once and hold them until the call with 0, at
+ * the end of mpmc_sim_step (only called when sim->bodies is set) */
+void mpmc_contact_step(struct mpmc_sim_s *sim, int begin);
 /* sets.c */
 void mpmc_sets_free(struct mpmc_sim_s *sim);
 int mpmc_material_validate_elastic(mpmc_context ctx, double E, double nu, double rho);

@@ -115,6 +115,7 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   int err = MPMC_SUCCESS;
   const double t0 = now();
   double t = t0;
+  if (sim->bodies) mpmc_contact_step(sim, 1); /* the barrier's parameters, once a step */
   if (!sim->force_dt) {
     const double limit = mpmc_stability_limit(sim, 1.0);
     if (!(dt <= limit))
@@ -136,6 +137,7 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
     sim->p.x = sim->x_lent;
     lap(sim, MPMC_PHASE_FBAR, &t);
   }
+  if (sim->bodies) mpmc_contact_step(sim, 0);
 #ifdef _OPENMP
   if (sim->nthreads > 0) omp_set_num_threads(saved);
 #endif
