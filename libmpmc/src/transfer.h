@@ -141,24 +141,33 @@ MPMC_ALWAYS_INLINE double mpmc_det_dim(const int DIM, const double *F) {
 /* Nodes per axis in a point's support in the J-bar space of the stable form. */
 MPMC_ALWAYS_INLINE int mpmc_stable_stencil(const int BASIS) { return BASIS == MPMC_BASIS_BSPLINE3 ? 3 : 2; }
 
+/* The stable form's space along one axis.  Linear, uGIMP: hats of spacing 2h on the grid
+ * nodes of the parity of lo's (x = lo, lo + 2h, ...); quadratic B-splines: hats of spacing h
+ * centred on the cells (the hat at lo + (k + 1/2) h kept in node k); cubic: quadratic
+ * B-splines centred on the cells, kept likewise.  Each is a basis of this file's
+ * (mpmc_stable_basis) of unit spacing at the argument MPMC_STABLE_ARG of s = (x - origin)/h;
+ * that basis's first node b is the grid node MPMC_STABLE_NODE(b), and its next ones follow
+ * mpmc_stable_step grid nodes apart.  The macros take scalars and vectors alike
+ * (mpmc_stable_1d, mpmc_stable_weights4: the same operations). */
+MPMC_ALWAYS_INLINE int mpmc_stable_hats2h(const int BASIS) {
+  return BASIS == MPMC_BASIS_LINEAR || BASIS == MPMC_BASIS_UGIMP;
+}
+MPMC_ALWAYS_INLINE int mpmc_stable_basis(const int BASIS) {
+  return BASIS == MPMC_BASIS_BSPLINE3 ? MPMC_BASIS_BSPLINE2 : MPMC_BASIS_LINEAR;
+}
+MPMC_ALWAYS_INLINE int mpmc_stable_step(const int BASIS) { return mpmc_stable_hats2h(BASIS) ? 2 : 1; }
+#define MPMC_STABLE_ARG(BASIS, s) \
+  (mpmc_stable_hats2h(BASIS) ? 0.5 * ((s) - MPMC_GHOST % 2) : (s) - 0.5)
+#define MPMC_STABLE_NODE(BASIS, b) (mpmc_stable_hats2h(BASIS) ? MPMC_GHOST % 2 + 2 * (b) : (b))
+
 /* 1D weights w of the stable form's space at s = (x - origin)/h: *base is the grid node that
- * stores the first of its nodes, the return value the step in grid nodes to the next one.
- * Linear, uGIMP: hats of spacing 2h on the grid nodes of the parity of lo's (x = lo, lo + 2h,
- * ...); quadratic B-splines: hats of spacing h centred on the cells (the hat at lo + (k + 1/2)
- * h kept in node k); cubic: quadratic B-splines centred on the cells, kept likewise. */
+ * stores the first of its nodes, the return value the step in grid nodes to the next one. */
 MPMC_ALWAYS_INLINE int mpmc_stable_1d(const int BASIS, double s, int *base, double *w) {
   double dw[3];
   int b;
-  if (BASIS == MPMC_BASIS_LINEAR || BASIS == MPMC_BASIS_UGIMP) {
-    const int par = MPMC_GHOST % 2; /* node of x = lo */
-    mpmc_basis_1d(MPMC_BASIS_LINEAR, 0.5 * (s - par), 0.0, 1.0, &b, w, dw);
-    *base = par + 2 * b;
-    return 2;
-  }
-  mpmc_basis_1d(BASIS == MPMC_BASIS_BSPLINE3 ? MPMC_BASIS_BSPLINE2 : MPMC_BASIS_LINEAR, s - 0.5,
-                0.0, 1.0, &b, w, dw);
-  *base = b;
-  return 1;
+  mpmc_basis_1d(mpmc_stable_basis(BASIS), MPMC_STABLE_ARG(BASIS, s), 0.0, 1.0, &b, w, dw);
+  *base = MPMC_STABLE_NODE(BASIS, b);
+  return mpmc_stable_step(BASIS);
 }
 
 typedef struct {
@@ -199,22 +208,12 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights4(const int DIM, const int BASIS, con
   for (int a = 0; a < DIM; ++a) {
     const mpmc_b4d xv = {x[(size_t)idx[0] * DIM + a], x[(size_t)idx[1] * DIM + a],
                          x[(size_t)idx[2] * DIM + a], x[(size_t)idx[3] * DIM + a]};
-    const mpmc_b4d s = (xv - g->origin[a]) * g->inv_h;
+    const mpmc_b4d s = (xv - g->origin[a]) * g->inv_h, sh = MPMC_STABLE_ARG(BASIS, s);
     mpmc_b4i b;
-    int k = 1;
-    if (BASIS == MPMC_BASIS_LINEAR || BASIS == MPMC_BASIS_UGIMP) { /* mpmc_stable_1d's cases */
-      const int par = MPMC_GHOST % 2;
-      const mpmc_b4d sh = 0.5 * (s - par);
-      mpmc_poly_lanes(MPMC_BASIS_LINEAR, &sh, 1.0, &b, (mpmc_b4da *)sp->w[a], NULL);
-      b = par + 2 * b;
-      k = 2;
-    } else {
-      const mpmc_b4d sh = s - 0.5;
-      mpmc_poly_lanes(BASIS == MPMC_BASIS_BSPLINE3 ? MPMC_BASIS_BSPLINE2 : MPMC_BASIS_LINEAR, &sh,
-                      1.0, &b, (mpmc_b4da *)sp->w[a], NULL);
-    }
+    mpmc_poly_lanes(mpmc_stable_basis(BASIS), &sh, 1.0, &b, (mpmc_b4da *)sp->w[a], NULL);
+    b = MPMC_STABLE_NODE(BASIS, b);
     node0 += (long long)str * __builtin_convertvector(b, mpmc_b4l);
-    sp->st[a] = str * (size_t)k;
+    sp->st[a] = str * (size_t)mpmc_stable_step(BASIS);
     str *= (size_t)g->n[a];
   }
   memcpy(sp->node0, &node0, sizeof node0);
