@@ -139,7 +139,7 @@ static inline double mpmc_sym3_norm2(const double *s) {
  * Returns 0, or 1 when |Z|_F > 0.179 (|eps| >~ 0.18: use the eigen path) or b is not
  * finite; a b with eigenvalues <= 0 gives |z| >= 1 or a singular b + I, so also 1. */
 /* the series' tables: the largest |Z|^2 for n terms, and the coefficients 1/(2k+1) (also
- * stress_j2.c's, which sums the same series four points at a time) */
+ * batch4.h's, which sums the same series four points at a time) */
 static const double mpmc_atanh_rho2_max[11] = {0.0,        1.665e-16,  1.666e-08, 7.297e-06,
                                                1.4949e-04, 9.0589e-04, 2.9934e-03, 7.0039e-03,
                                                1.3216e-02, 2.1619e-02, 3.2007e-02};

@@ -394,6 +394,7 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
   int mpmc_fbar##S(struct mpmc_sim_s *sim, int defer);         \
   void mpmc_fbar_gather_range##S(struct mpmc_sim_s *sim, int id, int q0, int q1, double *scale); \
   int mpmc_nh_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt); \
+  int mpmc_hencky_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt); \
   int mpmc_newtonian_batch##S(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt);
 /* phases of one step (step.c calls them in this order, mpmc_stress_update last) */
 MPMC_KERNEL_PROTOTYPES()
@@ -404,8 +405,8 @@ MPMC_KERNEL_PROTOTYPES(_avx512)
 #endif
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
 /* the sim's set of a material's update over blocks of four (stress_blocks.c), which the
- * material's ops->stress_update runs: model MPMC_MAT_NEO_HOOKEAN (mpmc_nh_batch) or
- * MPMC_MAT_NEWTONIAN (mpmc_newtonian_batch) */
+ * material's ops->stress_update runs: model MPMC_MAT_NEO_HOOKEAN (mpmc_nh_batch),
+ * MPMC_MAT_HENCKY (mpmc_hencky_batch) or MPMC_MAT_NEWTONIAN (mpmc_newtonian_batch) */
 typedef int (*mpmc_stress_batch_fn)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                                     double dt);
 mpmc_stress_batch_fn mpmc_kernels_stress_batch(const struct mpmc_sim_s *sim, int model);

@@ -1,16 +1,20 @@
-/* The Neo-Hookean and the Newtonian stress updates (material_neo_hookean.c,
- * material_newtonian.c) over blocks of four points, one of the kernel files compiled once per
- * instruction set (mpmc_impl.h, MPMC_ISA):
+/* The Neo-Hookean, Hencky and Newtonian stress updates (material_neo_hookean.c,
+ * material_hencky.c, material_newtonian.c) over blocks of four points, one of the kernel
+ * files compiled once per instruction set (mpmc_impl.h, MPMC_ISA):
  *   Neo-Hookean  b <- dF b dF^T,  J = sqrt(det b),  tau = mu (b - 1) + lambda ln J 1,
  *                sigma = tau / J  (plane strain: b_zz stays 1, dF embedded in 3 x 3);
+ *   Hencky       b <- dF b dF^T,  eps = 1/2 ln b,  J = sqrt(det b),
+ *                sigma = (K tr eps 1 + 2G dev eps) / J;
  *   Newtonian    sigma = K (J - 1) 1 + 2 mu dev(D),  D = sym(dF - 1) / dt, J the F-bar
  *                Jacobian when F-bar is on (formulas.md).
  * Four points of the material in a row (points 4k .. 4k + 3) go through them as vectors of
  * four doubles, lanes the points, with the operations of the point-by-point form in the same
  * order (batch4.h), so the same bits as one point alone in a set without contraction
- * (baseline, avx2: tests/t303, t413), but for ln J: mpmc_log_series' sum (linalg.h, within
- * 2 ulp), to the number of terms that the block's largest |J - 1| needs, and libm's log beyond
- * its reach (|ln J| >~ 0.36).  A block that holds another material's points or the end of the
+ * (baseline, avx2: tests/t303, t413), but for the series: the Neo-Hookean's ln J by
+ * mpmc_log_series' sum (linalg.h, within 2 ulp), to the number of terms that the block's
+ * largest |J - 1| needs, and libm's log beyond its reach (|ln J| >~ 0.36); Hencky's ln b by
+ * mpmc_sym3_log_series' to the degree of the block's largest strain (the terms beyond a
+ * point's own degree are below its 2^-54 tolerance).  A block that holds another material's points or the end of the
  * arrays goes point by point.  The blocks are fixed by the index, so the results do not
  * depend on the thread count.  The updates keep the stress guard themselves
  * (ops->checks_stress: the lowest non-finite point into sim->stress_bad, a pass over the
@@ -59,7 +63,7 @@ static inline int block_guard(const v4 *s, int q0) {
 /* ln x per lane by mpmc_log_series' sum (linalg.h) to the number of terms that the lanes'
  * largest s^2 needs (the terms beyond a lane's own number are below its 2^-54 tolerance),
  * libm's log in a lane beyond the series' reach */
-static inline void log_series4(const v4 *xp, v4 *lnx) {
+static inline void ln_series4(const v4 *xp, v4 *lnx) {
   const v4 x = *xp, s = (x - 1.0) / (x + 1.0), s2 = s * s;
   double s2max = 0.0;
   int out = 0;
@@ -108,7 +112,7 @@ static inline int nh_block(mpmc_particles *p, const int d, double mu, double lam
   v4 J;
   sqrt4(&det, &J);
   v4 lnJ;
-  log_series4(&J, &lnJ);
+  ln_series4(&J, &lnJ);
   const v4 inv_J = 1.0 / J;
   for (int k = 0; k < 6; ++k)
     s[k] = (mu * (bt[k] - (k < 3 ? one : zero)) + (k < 3 ? lam * lnJ : zero)) * inv_J;
@@ -124,6 +128,71 @@ int MPMC_ISA(mpmc_nh_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
   const int d = sim->dim;
   const double mu = mat->G, lam = mat->lambda;
   MPMC_BLOCKS(sim, id, nh_block(p, d, mu, lam, q0), nh_point(p, d, mu, lam, q));
+  return MPMC_SUCCESS;
+}
+
+/* ---- Hencky elasticity ---------------------------------------------------------------- */
+
+/* point q alone (kl = K - 2G/3): b <- dF b dF^T, eps = 1/2 ln b by the series or, beyond its
+ * reach, the eigen path (linalg.h), J = sqrt(det b) (= exp(tr eps)); returns 0 if its stress
+ * is not finite */
+static inline int hencky_point(mpmc_particles *p, const int d, double G2, double kl, int q) {
+  double F[3][3];
+  mpmc_embed(d, p->dF + (size_t)q * d * d, F);
+  double *b = p->be + (size_t)q * 6, *s = p->stress + (size_t)q * 6;
+  mpmc_push_forward(F, b);
+  double eps[6];
+  if (mpmc_sym3_log_series(b, eps)) mpmc_sym3_log_eig(b, eps);
+  const double tr = eps[0] + eps[1] + eps[2];
+  const double inv_J = 1.0 / sqrt(mpmc_det_sym(b)), p0 = kl * tr;
+  /* sigma = (K tr eps 1 + 2G dev eps) / J */
+  for (int k = 0; k < 6; ++k) s[k] = G2 * eps[k] * inv_J;
+  for (int k = 0; k < 3; ++k) s[k] += p0 * inv_J;
+  return mpmc_stress_finite(s);
+}
+
+/* the four points q0 .. q0 + 3, all of the material, as vectors: hencky_point's operations,
+ * the series to the degree of the block's largest strain (batch4.h, sym_log_series4); a block
+ * with a strain beyond the series goes point by point from its unchanged inputs.  Returns
+ * block_guard's point. */
+static inline int hencky_block(mpmc_particles *p, const int d, double G2, double kl, int q0) {
+  const v4 one = {1.0, 1.0, 1.0, 1.0};
+  const l4 all = {-1, -1, -1, -1};
+  v4 F[9], b[6], bt[6], eps[6], s[6];
+  l4 fail;
+  load_dF4(d, p->dF + (size_t)q0 * d * d, &one, F);
+  double *be = p->be + (size_t)q0 * 6;
+  load_rows6(be, b);
+  push_forward4(F, b, bt);
+  sym_log_series4(bt, &all, eps, &fail);
+  if (mask_bits(&fail)) {
+    int bad = INT_MAX;
+    for (int q = q0 + 3; q >= q0; --q)
+      if (!hencky_point(p, d, G2, kl, q)) bad = q;
+    return bad;
+  }
+  const v4 tr = eps[0] + eps[1] + eps[2];
+  /* mpmc_det_sym's order */
+  const v4 det = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
+                 bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
+  v4 J;
+  sqrt4(&det, &J);
+  const v4 inv_J = 1.0 / J, p0 = kl * tr;
+  for (int k = 0; k < 6; ++k) s[k] = G2 * eps[k] * inv_J;
+  for (int k = 0; k < 3; ++k) s[k] += p0 * inv_J;
+  store_rows6(bt, be);
+  store_rows6(s, p->stress + (size_t)q0 * 6);
+  return block_guard(s, q0);
+}
+
+/** The stress update of material id's points (Hencky: mat->K, mat->G). */
+int MPMC_ISA(mpmc_hencky_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
+                                double dt) {
+  (void)dt;
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  const double G2 = 2.0 * mat->G, kl = mat->K - G2 / 3.0;
+  MPMC_BLOCKS(sim, id, hencky_block(p, d, G2, kl, q0), hencky_point(p, d, G2, kl, q));
   return MPMC_SUCCESS;
 }
 

@@ -30,78 +30,6 @@
 
 #define J2_CHUNK 64 /* blocks of four points handed to a thread at a time */
 
-/* lanes of a where mask m is set, else of b; |a| per lane; the mask's lanes as bits */
-#define SEL4(m, a, b) ((v4)(((m) & (l4)(a)) | (~(m) & (l4)(b))))
-#define ABS4(a) ((v4)((l4)(a) & ~(l4)(v4){-0.0, -0.0, -0.0, -0.0}))
-static inline int mask_bits(const l4 *m) {
-#if defined(__AVX__)
-  return _mm256_movemask_pd((__m256d)*m);
-#else
-  return (int)(((*m)[0] & 1) | ((*m)[1] & 2) | ((*m)[2] & 4) | ((*m)[3] & 8));
-#endif
-}
-/* the largest lane of r among those of mask m (0 for none; r's lanes are >= 0 or NaN) */
-static inline double max_lane(const v4 *r, const l4 *m) {
-  const v4 zero = {0.0, 0.0, 0.0, 0.0}, v = SEL4(*m, *r, zero);
-  double x = 0.0;
-  for (int l = 0; l < 4; ++l) x = v[l] > x ? v[l] : x;
-  return x;
-}
-
-/* c = a b for symmetric a, b (Voigt) that commute, as mpmc_sym3_mul */
-static inline void sym_mul4(const v4 *a, const v4 *b, v4 *c) {
-  const v4 xx = a[0] * b[0] + a[5] * b[5] + a[4] * b[4];
-  const v4 yy = a[5] * b[5] + a[1] * b[1] + a[3] * b[3];
-  const v4 zz = a[4] * b[4] + a[3] * b[3] + a[2] * b[2];
-  const v4 yz = a[5] * b[4] + a[1] * b[3] + a[3] * b[2];
-  const v4 xz = a[0] * b[4] + a[5] * b[3] + a[4] * b[2];
-  const v4 xy = a[0] * b[5] + a[5] * b[1] + a[4] * b[3];
-  c[0] = xx, c[1] = yy, c[2] = zz, c[3] = yz, c[4] = xz, c[5] = xy;
-}
-
-/* |s|^2 (Voigt, tensor shear components), as mpmc_sym3_norm2 (through a pointer: a v4
- * returned by value would change the baseline build's ABI) */
-static inline void norm2_4(const v4 *s, v4 *r) {
-  *r = s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
-}
-
-/* The block's trial Hencky strain eps = 1/2 ln b by linalg.h's series (same tables and
- * Horner scheme), at the degree the largest active lane (mask am) needs.  fail: the lanes
- * whose strain the series cannot take (|Z|^2 above the table, or not finite). */
-static inline void log_series4(const v4 *b, const l4 *am, v4 *eps, l4 *fail) {
-  const double *rho2_max = mpmc_atanh_rho2_max, *c = mpmc_atanh_c;
-  const v4 a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
-  const v4 m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
-  const v4 adj[6] = {m[1] * m[2] - m[3] * m[3], m[0] * m[2] - m[4] * m[4],
-                     m[0] * m[1] - m[5] * m[5], m[4] * m[5] - m[0] * m[3],
-                     m[5] * m[3] - m[1] * m[4], m[4] * m[3] - m[2] * m[5]};
-  const v4 det = m[0] * adj[0] + m[5] * adj[5] + m[4] * adj[4];
-  v4 z[6], w[6], p[6];
-  sym_mul4(a, adj, z);
-  const v4 inv_det = 1.0 / det;
-  for (int k = 0; k < 6; ++k) z[k] *= inv_det;
-  v4 r2;
-  norm2_4(z, &r2);
-  /* fail: |Z|^2 beyond the table or not finite; the degree: that of the largest other lane */
-  const l4 ok = *am & (r2 <= rho2_max[10]);
-  *fail = *am & ~ok;
-  int n = 1;
-  const double rmax = max_lane(&r2, &ok);
-  while (rmax > rho2_max[n]) ++n;
-  if (n == 1) {
-    for (int k = 0; k < 6; ++k) eps[k] = z[k];
-    return;
-  }
-  sym_mul4(z, z, w);
-  for (int k = 0; k < 6; ++k) p[k] = c[n - 1] * w[k];
-  for (int k = 0; k < 3; ++k) p[k] += c[n - 2];
-  for (int j = n - 3; j >= 0; --j) {
-    sym_mul4(w, p, p);
-    for (int k = 0; k < 3; ++k) p[k] += c[j];
-  }
-  sym_mul4(z, p, eps);
-}
-
 /* The plastic lanes of a block (mask *pl) returned together, for the auto solver:
  * return_map.c's Newton iteration (solve_newton, strict) lane by lane in vectors -- the
  * same operations in the same order, the branches taken per lane, so each lane gets the
@@ -271,7 +199,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         const l4 am = {-(long long)act[0], -(long long)act[1], -(long long)act[2],
                        -(long long)act[3]};
         l4 fail;
-        log_series4(bt, &am, eps, &fail);
+        sym_log_series4(bt, &am, eps, &fail);
         const v4 tr = eps[0] + eps[1] + eps[2];
         for (int k = 0; k < 6; ++k) e[k] = eps[k];
         for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
