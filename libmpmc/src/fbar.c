@@ -387,8 +387,9 @@ MPMC_KERNELS(FBAR_KERNELS)
  * holds every point's support in every form (the cubic B-spline's reach, c - 1 .. c + 2, is
  * the widest; the stable form's spaces reach no further; t302 checks it).
  * defer: the step's call.  When every material's update runs the gather itself
- * (ops->gathers_fbar: Hencky-J2), the gather is left to it (grid.fb_gather): each thread
- * gathers its points' factors into sim->fb_scale (allocated here) just before it updates
+ * (ops->gathers_fbar: every built-in model, not a user material), the gather is left to it
+ * (grid.fb_gather; stress_j2.c, stress_blocks.c's MPMC_BLOCKS): each thread gathers its
+ * points' factors into sim->fb_scale (allocated here) just before it updates
  * them, and the update scales dF as it loads it, so dF is read once and written never
  * instead of read, scaled, written and read again (the landslide's points do not fit in the
  * cache: a pass less over 311,250 of them).  Same bits either way. */

@@ -15,4 +15,4 @@ static double hencky_wave_speed(const mpmc_material *m) {
   return sqrt((m->K + 4.0 / 3.0 * m->G) / m->rho);
 }
 
-const mpmc_material_ops mpmc_ops_hencky = {"hencky", hencky_update, hencky_wave_speed, 0, 1};
+const mpmc_material_ops mpmc_ops_hencky = {"hencky", hencky_update, hencky_wave_speed, 1, 1};

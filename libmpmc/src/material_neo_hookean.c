@@ -14,4 +14,4 @@ static double nh_wave_speed(const mpmc_material *m) {
   return sqrt((m->lambda + 2.0 * m->G) / m->rho);
 }
 
-const mpmc_material_ops mpmc_ops_neo_hookean = {"neo_hookean", nh_update, nh_wave_speed, 0, 1};
+const mpmc_material_ops mpmc_ops_neo_hookean = {"neo_hookean", nh_update, nh_wave_speed, 1, 1};

@@ -11,4 +11,4 @@ static int newtonian_update(mpmc_sim sim, const mpmc_material *mat, int id, doub
 
 static double newtonian_wave_speed(const mpmc_material *m) { return sqrt(m->K / m->rho); }
 
-const mpmc_material_ops mpmc_ops_newtonian = {"newtonian", newtonian_update, newtonian_wave_speed, 0, 1};
+const mpmc_material_ops mpmc_ops_newtonian = {"newtonian", newtonian_update, newtonian_wave_speed, 1, 1};

@@ -35,28 +35,67 @@ static inline int block_guard(const v4 *s, int q0) {
   return INT_MAX;
 }
 
-/* The loop of both updates over material id's points: BLOCK (an expression of q0, the lowest
- * non-finite point of the block or INT_MAX) for four of them in a row, else POINT (of q, 0 if
- * its stress is not finite) one by one; the lowest non-finite point into sim->stress_bad.  A
- * macro, for the OpenMP region to see BLOCK and POINT inlined (transfer.h, MPMC_KERNELS). */
+/* blocks of four handed to a thread at a time (and F-bar's deferred gather's chunks) */
+#define BLOCKS_CHUNK 64
+
+/* The loop of the updates over material id's points: BLOCK (an expression of q0 and sc, the
+ * lowest non-finite point of the block or INT_MAX) for four of them in a row, else POINT (of q
+ * and s, 0 if its stress is not finite) one by one; the lowest non-finite point into
+ * sim->stress_bad.  sc: the block's F-bar factors of dF (sc[0..3]; NULL: none), s point q's
+ * (1 for none).  With F-bar's gather left to the update (grid.fb_gather, fbar.c) each thread
+ * first gathers its chunks' points into sim->fb_scale (their factors; Jbar becomes Pi) and
+ * then updates them, dF-bar = s dF formed as dF is loaded, as the Hencky-J2 blocks do
+ * (stress_j2.c): the two loops' static schedules over the same chunks give a thread the same
+ * points, so it reads only factors it wrote (nowait).  A macro, for the OpenMP region to see
+ * BLOCK and POINT inlined (transfer.h, MPMC_KERNELS). */
 #define MPMC_BLOCKS(sim, id, BLOCK, POINT)                                                   \
   do {                                                                                       \
     const int n_ = (sim)->p.n, nblk_ = (n_ + 3) / 4, *restrict m_ = (sim)->p.mat;            \
+    const int nch_ = (nblk_ + BLOCKS_CHUNK - 1) / BLOCKS_CHUNK, gather_ = (sim)->grid.fb_gather; \
+    double *const fs_ = (sim)->fb_scale;                                                     \
     int first_nf_ = INT_MAX;                                                                 \
-    _Pragma("omp parallel for schedule(static) reduction(min : first_nf_) if (n_ > MPMC_OMP_MIN)") \
-    for (int blk_ = 0; blk_ < nblk_; ++blk_) {                                               \
-      const int q0 = 4 * blk_;                                                               \
-      if (q0 + 3 < n_ && m_[q0] == (id) && m_[q0 + 1] == (id) && m_[q0 + 2] == (id) &&       \
-          m_[q0 + 3] == (id)) {                                                              \
-        const int bad_ = (BLOCK);                                                            \
-        first_nf_ = bad_ < first_nf_ ? bad_ : first_nf_;                                     \
-      } else {                                                                               \
-        for (int q = q0; q < q0 + 4 && q < n_; ++q)                                          \
-          if (m_[q] == (id) && !(POINT) && q < first_nf_) first_nf_ = q;                     \
+    _Pragma("omp parallel reduction(min : first_nf_) if (n_ > MPMC_OMP_MIN)")                \
+    {                                                                                        \
+      if (gather_) {                                                                         \
+        _Pragma("omp for schedule(static) nowait")                                           \
+        for (int ch_ = 0; ch_ < nch_; ++ch_) {                                               \
+          const int c0_ = 4 * BLOCKS_CHUNK * ch_, c1_ = c0_ + 4 * BLOCKS_CHUNK < n_ ? c0_ + 4 * BLOCKS_CHUNK : n_; \
+          MPMC_ISA(mpmc_fbar_gather_range)((sim), (id), c0_, c1_, fs_ + c0_);               \
+        }                                                                                    \
+      }                                                                                      \
+      _Pragma("omp for schedule(static)")                                                    \
+      for (int ch_ = 0; ch_ < nch_; ++ch_) {                                                 \
+        const int b1_ = BLOCKS_CHUNK * (ch_ + 1) < nblk_ ? BLOCKS_CHUNK * (ch_ + 1) : nblk_; \
+        for (int blk_ = BLOCKS_CHUNK * ch_; blk_ < b1_; ++blk_) {                            \
+          const int q0 = 4 * blk_;                                                           \
+          const double *const sc = gather_ ? fs_ + q0 : NULL;                                \
+          if (q0 + 3 < n_ && m_[q0] == (id) && m_[q0 + 1] == (id) && m_[q0 + 2] == (id) &&   \
+              m_[q0 + 3] == (id)) {                                                          \
+            const int bad_ = (BLOCK);                                                        \
+            first_nf_ = bad_ < first_nf_ ? bad_ : first_nf_;                                 \
+          } else {                                                                           \
+            for (int q = q0; q < q0 + 4 && q < n_; ++q) {                                    \
+              const double s = gather_ ? fs_[q] : 1.0;                                       \
+              if (m_[q] == (id) && !(POINT) && q < first_nf_) first_nf_ = q;                 \
+            }                                                                                \
+          }                                                                                  \
+        }                                                                                    \
       }                                                                                      \
     }                                                                                        \
     if (first_nf_ < (sim)->stress_bad) (sim)->stress_bad = first_nf_; /* stress_update.c */  \
   } while (0)
+
+/* the block's factors (ones for none) */
+static inline void block_scale(const double *sc, v4 *f) {
+  *f = sc ? (v4) * (const v4u *)sc : (v4){1.0, 1.0, 1.0, 1.0};
+}
+
+/* point q's dF-bar = s dF, embedded in 3 x 3 (as fbar.c's scale_dF, then mpmc_embed) */
+static inline void point_dF(const mpmc_particles *p, const int d, int q, double s, double F[3][3]) {
+  const double *f = p->dF + (size_t)q * d * d;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) F[i][j] = i < d && j < d ? f[i * d + j] * s : (double)(i == j);
+}
 
 /* ---- Neo-Hookean ---------------------------------------------------------------------- */
 
@@ -81,9 +120,10 @@ static inline void ln_series4(const v4 *xp, v4 *lnx) {
 }
 
 /* point q alone; returns 0 if its stress is not finite */
-static inline int nh_point(mpmc_particles *p, const int d, double mu, double lam, int q) {
+static inline int nh_point(mpmc_particles *p, const int d, double mu, double lam, double sc,
+                           int q) {
   double F[3][3];
-  mpmc_embed(d, p->dF + (size_t)q * d * d, F);
+  point_dF(p, d, q, sc, F);
   double *b = p->be + (size_t)q * 6;
   mpmc_push_forward(F, b);
   const double J = sqrt(mpmc_det_sym(b)), inv_J = 1.0 / J;
@@ -99,10 +139,12 @@ static inline int nh_point(mpmc_particles *p, const int d, double mu, double lam
 
 /* the four points q0 .. q0 + 3, all of the material, as vectors: nh_point's operations;
  * returns block_guard's point */
-static inline int nh_block(mpmc_particles *p, const int d, double mu, double lam, int q0) {
+static inline int nh_block(mpmc_particles *p, const int d, double mu, double lam,
+                           const double *sc, int q0) {
   const v4 one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
-  v4 F[9], b[6], bt[6], s[6];
-  load_dF4(d, p->dF + (size_t)q0 * d * d, &one, F);
+  v4 F[9], b[6], bt[6], s[6], f;
+  block_scale(sc, &f);
+  load_dF4(d, p->dF + (size_t)q0 * d * d, &f, F);
   double *be = p->be + (size_t)q0 * 6;
   load_rows6(be, b);
   push_forward4(F, b, bt);
@@ -127,7 +169,7 @@ int MPMC_ISA(mpmc_nh_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
   mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   const double mu = mat->G, lam = mat->lambda;
-  MPMC_BLOCKS(sim, id, nh_block(p, d, mu, lam, q0), nh_point(p, d, mu, lam, q));
+  MPMC_BLOCKS(sim, id, nh_block(p, d, mu, lam, sc, q0), nh_point(p, d, mu, lam, s, q));
   return MPMC_SUCCESS;
 }
 
@@ -136,9 +178,10 @@ int MPMC_ISA(mpmc_nh_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
 /* point q alone (kl = K - 2G/3): b <- dF b dF^T, eps = 1/2 ln b by the series or, beyond its
  * reach, the eigen path (linalg.h), J = sqrt(det b) (= exp(tr eps)); returns 0 if its stress
  * is not finite */
-static inline int hencky_point(mpmc_particles *p, const int d, double G2, double kl, int q) {
+static inline int hencky_point(mpmc_particles *p, const int d, double G2, double kl, double sc,
+                               int q) {
   double F[3][3];
-  mpmc_embed(d, p->dF + (size_t)q * d * d, F);
+  point_dF(p, d, q, sc, F);
   double *b = p->be + (size_t)q * 6, *s = p->stress + (size_t)q * 6;
   mpmc_push_forward(F, b);
   double eps[6];
@@ -155,12 +198,13 @@ static inline int hencky_point(mpmc_particles *p, const int d, double G2, double
  * the series to the degree of the block's largest strain (batch4.h, sym_log_series4); a block
  * with a strain beyond the series goes point by point from its unchanged inputs.  Returns
  * block_guard's point. */
-static inline int hencky_block(mpmc_particles *p, const int d, double G2, double kl, int q0) {
-  const v4 one = {1.0, 1.0, 1.0, 1.0};
+static inline int hencky_block(mpmc_particles *p, const int d, double G2, double kl,
+                               const double *sc, int q0) {
   const l4 all = {-1, -1, -1, -1};
-  v4 F[9], b[6], bt[6], eps[6], s[6];
+  v4 F[9], b[6], bt[6], eps[6], s[6], f;
   l4 fail;
-  load_dF4(d, p->dF + (size_t)q0 * d * d, &one, F);
+  block_scale(sc, &f);
+  load_dF4(d, p->dF + (size_t)q0 * d * d, &f, F);
   double *be = p->be + (size_t)q0 * 6;
   load_rows6(be, b);
   push_forward4(F, b, bt);
@@ -168,7 +212,7 @@ static inline int hencky_block(mpmc_particles *p, const int d, double G2, double
   if (mask_bits(&fail)) {
     int bad = INT_MAX;
     for (int q = q0 + 3; q >= q0; --q)
-      if (!hencky_point(p, d, G2, kl, q)) bad = q;
+      if (!hencky_point(p, d, G2, kl, sc ? sc[q - q0] : 1.0, q)) bad = q;
     return bad;
   }
   const v4 tr = eps[0] + eps[1] + eps[2];
@@ -192,7 +236,7 @@ int MPMC_ISA(mpmc_hencky_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat
   mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   const double G2 = 2.0 * mat->G, kl = mat->K - G2 / 3.0;
-  MPMC_BLOCKS(sim, id, hencky_block(p, d, G2, kl, q0), hencky_point(p, d, G2, kl, q));
+  MPMC_BLOCKS(sim, id, hencky_block(p, d, G2, kl, sc, q0), hencky_point(p, d, G2, kl, s, q));
   return MPMC_SUCCESS;
 }
 
@@ -211,11 +255,11 @@ int MPMC_ISA(mpmc_hencky_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat
 
 /* point q alone (Jm: J or Jbar); returns 0 if its stress is not finite */
 static inline int newtonian_point(mpmc_particles *p, const int d, double K, double mu2,
-                                  double inv_dt, const double *Jm, int q) {
-  const double *f = p->dF + (size_t)q * d * d;
-  double D[3][3] = {{0}};
+                                  double inv_dt, const double *Jm, double sc, int q) {
+  double f[3][3], D[3][3] = {{0}};
+  point_dF(p, d, q, sc, f);
   for (int a = 0; a < d; ++a)
-    for (int b = 0; b < d; ++b) D[a][b] = 0.5 * (f[a * d + b] + f[b * d + a]) * inv_dt;
+    for (int b = 0; b < d; ++b) D[a][b] = 0.5 * (f[a][b] + f[b][a]) * inv_dt;
   for (int a = 0; a < d; ++a) D[a][a] -= inv_dt;
   const double trD = (D[0][0] + D[1][1] + D[2][2]) / 3.0;
   const double pr = K * (Jm[q] - 1.0);
@@ -227,10 +271,11 @@ static inline int newtonian_point(mpmc_particles *p, const int d, double K, doub
 /* the four points q0 .. q0 + 3 as vectors: newtonian_point's operations; returns
  * block_guard's point */
 static inline int newtonian_block(mpmc_particles *p, const int d, double K, double mu2,
-                                  double inv_dt, const double *Jm, int q0) {
-  const v4 one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
-  v4 F[9], D[3][3], s[6];
-  load_dF4(d, p->dF + (size_t)q0 * d * d, &one, F);
+                                  double inv_dt, const double *Jm, const double *sc, int q0) {
+  const v4 zero = {0.0, 0.0, 0.0, 0.0};
+  v4 F[9], D[3][3], s[6], f;
+  block_scale(sc, &f);
+  load_dF4(d, p->dF + (size_t)q0 * d * d, &f, F);
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b)
       D[a][b] = a < d && b < d ? 0.5 * (F[3 * a + b] + F[3 * b + a]) * inv_dt : zero;
@@ -249,7 +294,7 @@ int MPMC_ISA(mpmc_newtonian_batch)(struct mpmc_sim_s *sim, const mpmc_material *
   const int d = sim->dim;
   const double K = mat->K, mu2 = 2.0 * mat->mu, inv_dt = dt > 0 ? 1.0 / dt : 0.0;
   const double *Jm = sim->fbar ? p->Jbar : p->J;
-  MPMC_BLOCKS(sim, id, newtonian_block(p, d, K, mu2, inv_dt, Jm, q0),
-              newtonian_point(p, d, K, mu2, inv_dt, Jm, q));
+  MPMC_BLOCKS(sim, id, newtonian_block(p, d, K, mu2, inv_dt, Jm, sc, q0),
+              newtonian_point(p, d, K, mu2, inv_dt, Jm, s, q));
   return MPMC_SUCCESS;
 }

@@ -1,6 +1,6 @@
-/* Stress update: each material updates its points from dF (dF-bar with F-bar on, which
- * Hencky-J2 forms itself when the step left F-bar's gather to it: fbar.c), batched over the
- * particle arrays; then the step's guard against NaN/Inf stress. */
+/* Stress update: each material updates its points from dF (dF-bar with F-bar on, which the
+ * built-in materials form themselves when the step left F-bar's gather to them: fbar.c),
+ * batched over the particle arrays; then the step's guard against NaN/Inf stress. */
 #include <limits.h>
 #include <math.h>
 
