@@ -14,11 +14,12 @@
  * mpmc_log_series' sum (linalg.h, within 2 ulp), to the number of terms that the block's
  * largest |J - 1| needs, and libm's log beyond its reach (|ln J| >~ 0.36); Hencky's ln b by
  * mpmc_sym3_log_series' to the degree of the block's largest strain (the terms beyond a
- * point's own degree are below its 2^-54 tolerance).  A block that holds another material's points or the end of the
- * arrays goes point by point.  The blocks are fixed by the index, so the results do not
- * depend on the thread count.  The updates keep the stress guard themselves
+ * point's own degree are below its 2^-54 tolerance).  A block that holds another material's
+ * points or the end of the arrays goes point by point.  The blocks are fixed by the index, so
+ * the results do not depend on the thread count.  The updates keep the stress guard themselves
  * (ops->checks_stress: the lowest non-finite point into sim->stress_bad, a pass over the
- * stresses less). */
+ * stresses less) and run F-bar's gather when the step leaves it to them (ops->gathers_fbar,
+ * MPMC_BLOCKS). */
 #include <limits.h>
 #include <math.h>
 
@@ -51,7 +52,8 @@ static inline int block_guard(const v4 *s, int q0) {
 #define MPMC_BLOCKS(sim, id, BLOCK, POINT)                                                   \
   do {                                                                                       \
     const int n_ = (sim)->p.n, nblk_ = (n_ + 3) / 4, *restrict m_ = (sim)->p.mat;            \
-    const int nch_ = (nblk_ + BLOCKS_CHUNK - 1) / BLOCKS_CHUNK, gather_ = (sim)->grid.fb_gather; \
+    const int nch_ = (nblk_ + BLOCKS_CHUNK - 1) / BLOCKS_CHUNK;                               \
+    const int gather_ = (sim)->grid.fb_gather;                                               \
     double *const fs_ = (sim)->fb_scale;                                                     \
     int first_nf_ = INT_MAX;                                                                 \
     _Pragma("omp parallel reduction(min : first_nf_) if (n_ > MPMC_OMP_MIN)")                \
@@ -59,7 +61,8 @@ static inline int block_guard(const v4 *s, int q0) {
       if (gather_) {                                                                         \
         _Pragma("omp for schedule(static) nowait")                                           \
         for (int ch_ = 0; ch_ < nch_; ++ch_) {                                               \
-          const int c0_ = 4 * BLOCKS_CHUNK * ch_, c1_ = c0_ + 4 * BLOCKS_CHUNK < n_ ? c0_ + 4 * BLOCKS_CHUNK : n_; \
+          const int c0_ = 4 * BLOCKS_CHUNK * ch_;                                           \
+          const int c1_ = c0_ + 4 * BLOCKS_CHUNK < n_ ? c0_ + 4 * BLOCKS_CHUNK : n_;         \
           MPMC_ISA(mpmc_fbar_gather_range)((sim), (id), c0_, c1_, fs_ + c0_);               \
         }                                                                                    \
       }                                                                                      \
@@ -75,8 +78,9 @@ static inline int block_guard(const v4 *s, int q0) {
             first_nf_ = bad_ < first_nf_ ? bad_ : first_nf_;                                 \
           } else {                                                                           \
             for (int q = q0; q < q0 + 4 && q < n_; ++q) {                                    \
+              if (m_[q] != (id)) continue; /* (its factor not gathered) */                   \
               const double s = gather_ ? fs_[q] : 1.0;                                       \
-              if (m_[q] == (id) && !(POINT) && q < first_nf_) first_nf_ = q;                 \
+              if (!(POINT) && q < first_nf_) first_nf_ = q;                                  \
             }                                                                                \
           }                                                                                  \
         }                                                                                    \
