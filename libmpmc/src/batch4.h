@@ -9,6 +9,7 @@
 
 #include "basis.h"
 #include "linalg.h"
+#include "mpmc_impl.h"
 #if defined(__AVX__)
 #include <immintrin.h>
 #endif
@@ -78,6 +79,27 @@ static inline void load_dF4(const int d, const double *f, const v4 *scp, v4 *F) 
       F[k] = i < 2 && j < 2 ? c[2 * i + j] * sc : (v4){i == j, i == j, i == j, i == j};
     }
   }
+}
+
+/* det b of symmetric b (Voigt) per lane, in mpmc_det_sym's order (linalg.h), so the same bits
+ * per lane (through a pointer, as sqrt4) */
+static inline void det_sym4(const v4 *b, v4 *r) {
+  *r = b[0] * (b[1] * b[2] - b[3] * b[3]) - b[5] * (b[5] * b[2] - b[3] * b[4]) +
+       b[4] * (b[5] * b[3] - b[1] * b[4]);
+}
+
+/* blocks of four that the batched updates hand to a thread at a time (stress_j2.c,
+ * stress_blocks.c), also the chunks of F-bar's deferred gather */
+#define MPMC_BLOCK_CHUNK 64
+
+/* F-bar's deferred gather (fbar.c, grid.fb_gather) of chunk ch's points of material id, of
+ * nblk blocks over n points: their factors into sim->fb_scale, which the update reads as it
+ * loads dF */
+static inline void fbar_gather_chunk(struct mpmc_sim_s *sim, int id, int ch, int nblk, int n) {
+  const int b0 = ch * MPMC_BLOCK_CHUNK;
+  const int b1 = b0 + MPMC_BLOCK_CHUNK < nblk ? b0 + MPMC_BLOCK_CHUNK : nblk;
+  const int c0 = 4 * b0, c1 = 4 * b1 < n ? 4 * b1 : n;
+  MPMC_ISA(mpmc_fbar_gather_range)(sim, id, c0, c1, sim->fb_scale + c0); /* [q - c0] */
 }
 
 /* bt = F b F^T (Voigt) in mpmc_push_forward's order (linalg.h), so the same bits per lane:

@@ -332,8 +332,8 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
     if (one || mat[q] == id) scale[q - q0] = gather_scale1(sim, D, B, ST, xs, q);
 }
 
-/* points the gather of the fbar phase takes at a time (the deferred one goes by the J2
- * update's chunks: stress_j2.c) */
+/* points the gather of the fbar phase takes at a time (the deferred one goes by the batched
+ * updates' chunks: batch4.h, fbar_gather_chunk) */
 #define GATHER_CHUNK 256
 
 /* The F-bar phase's gather (ST: the stable form's): every point's, GATHER_CHUNK at a time,

@@ -36,9 +36,6 @@ static inline int block_guard(const v4 *s, int q0) {
   return INT_MAX;
 }
 
-/* blocks of four handed to a thread at a time (and F-bar's deferred gather's chunks) */
-#define BLOCKS_CHUNK 64
-
 /* The loop of the updates over material id's points: BLOCK (an expression of q0 and sc, the
  * lowest non-finite point of the block or INT_MAX) for four of them in a row, else POINT (of q
  * and s, 0 if its stress is not finite) one by one; the lowest non-finite point into
@@ -52,7 +49,7 @@ static inline int block_guard(const v4 *s, int q0) {
 #define MPMC_BLOCKS(sim, id, BLOCK, POINT)                                                   \
   do {                                                                                       \
     const int n_ = (sim)->p.n, nblk_ = (n_ + 3) / 4, *restrict m_ = (sim)->p.mat;            \
-    const int nch_ = (nblk_ + BLOCKS_CHUNK - 1) / BLOCKS_CHUNK;                               \
+    const int nch_ = (nblk_ + MPMC_BLOCK_CHUNK - 1) / MPMC_BLOCK_CHUNK;                       \
     const int gather_ = (sim)->grid.fb_gather;                                               \
     double *const fs_ = (sim)->fb_scale;                                                     \
     int first_nf_ = INT_MAX;                                                                 \
@@ -60,16 +57,13 @@ static inline int block_guard(const v4 *s, int q0) {
     {                                                                                        \
       if (gather_) {                                                                         \
         _Pragma("omp for schedule(static) nowait")                                           \
-        for (int ch_ = 0; ch_ < nch_; ++ch_) {                                               \
-          const int c0_ = 4 * BLOCKS_CHUNK * ch_;                                           \
-          const int c1_ = c0_ + 4 * BLOCKS_CHUNK < n_ ? c0_ + 4 * BLOCKS_CHUNK : n_;         \
-          MPMC_ISA(mpmc_fbar_gather_range)((sim), (id), c0_, c1_, fs_ + c0_);               \
-        }                                                                                    \
+        for (int ch_ = 0; ch_ < nch_; ++ch_) fbar_gather_chunk((sim), (id), ch_, nblk_, n_);  \
       }                                                                                      \
       _Pragma("omp for schedule(static)")                                                    \
       for (int ch_ = 0; ch_ < nch_; ++ch_) {                                                 \
-        const int b1_ = BLOCKS_CHUNK * (ch_ + 1) < nblk_ ? BLOCKS_CHUNK * (ch_ + 1) : nblk_; \
-        for (int blk_ = BLOCKS_CHUNK * ch_; blk_ < b1_; ++blk_) {                            \
+        const int b0_ = MPMC_BLOCK_CHUNK * ch_;                                              \
+        const int b1_ = b0_ + MPMC_BLOCK_CHUNK < nblk_ ? b0_ + MPMC_BLOCK_CHUNK : nblk_;     \
+        for (int blk_ = b0_; blk_ < b1_; ++blk_) {                                           \
           const int q0 = 4 * blk_;                                                           \
           const double *const sc = gather_ ? fs_ + q0 : NULL;                                \
           if (q0 + 3 < n_ && m_[q0] == (id) && m_[q0 + 1] == (id) && m_[q0 + 2] == (id) &&   \
@@ -152,10 +146,8 @@ static inline int nh_block(mpmc_particles *p, const int d, double mu, double lam
   double *be = p->be + (size_t)q0 * 6;
   load_rows6(be, b);
   push_forward4(F, b, bt);
-  /* mpmc_det_sym's order */
-  const v4 det = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
-                 bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
-  v4 J;
+  v4 det, J;
+  det_sym4(bt, &det);
   sqrt4(&det, &J);
   v4 lnJ;
   ln_series4(&J, &lnJ);
@@ -220,10 +212,8 @@ static inline int hencky_block(mpmc_particles *p, const int d, double G2, double
     return bad;
   }
   const v4 tr = eps[0] + eps[1] + eps[2];
-  /* mpmc_det_sym's order */
-  const v4 det = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
-                 bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
-  v4 J;
+  v4 det, J;
+  det_sym4(bt, &det);
   sqrt4(&det, &J);
   const v4 inv_J = 1.0 / J, p0 = kl * tr;
   for (int k = 0; k < 6; ++k) s[k] = G2 * eps[k] * inv_J;

@@ -28,7 +28,6 @@
 #include <immintrin.h>
 #endif
 
-#define J2_CHUNK 64 /* blocks of four points handed to a thread at a time */
 
 /* The plastic lanes of a block (mask *pl) returned together, for the auto solver:
  * return_map.c's Newton iteration (solve_newton, strict) lane by lane in vectors -- the
@@ -121,7 +120,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
   const int d = sim->dim, solver = sim->solver, n = p->n;
   const mpmc_j2_param par = {mat->K, mat->G, mat->kappa_p, mat->kappa_r, mat->eta};
   const double G2 = 2.0 * par.G, K = par.K;
-  const int nblk = (n + 3) / 4, nchunk = (nblk + J2_CHUNK - 1) / J2_CHUNK;
+  const int nblk = (n + 3) / 4, nchunk = (nblk + MPMC_BLOCK_CHUNK - 1) / MPMC_BLOCK_CHUNK;
   const int gather = sim->grid.fb_gather;
   int64_t nret = 0, nfb = 0;
   int first_bad = INT_MAX, first_nf = INT_MAX; /* failed return map; non-finite stress */
@@ -141,7 +140,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
      * so a dynamic schedule balanced better; but it moved the points between the cores
      * every step, which cost more (the landslide's states at the run-out's start and 4 s
      * on two threads: the update 8.7 -> 7.7 and 9.6 -> 8.2 ms a step, docs/benchmarks.md).
-     * Chunks of J2_CHUNK blocks.  With F-bar's gather deferred to here (grid.fb_gather,
+     * Chunks of MPMC_BLOCK_CHUNK blocks.  With F-bar's gather deferred to here (grid.fb_gather,
      * fbar.c) each thread first gathers all of its chunks' points into sim->fb_scale, then
      * updates them, forming dF-bar = scale dF as dF is loaded; the two loops' static
      * schedules give a thread the same chunks, so it reads only factors it wrote (nowait).
@@ -149,15 +148,12 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
      * stress) waited behind the gather's (x^n, Jbar): docs/benchmarks.md. */
     if (gather) {
 #pragma omp for schedule(static) nowait
-      for (int ch = 0; ch < nchunk; ++ch) {
-        const int b0 = ch * J2_CHUNK, b1 = b0 + J2_CHUNK < nblk ? b0 + J2_CHUNK : nblk;
-        const int c0 = 4 * b0, c1 = 4 * b1 < n ? 4 * b1 : n;
-        MPMC_ISA(mpmc_fbar_gather_range)(sim, id, c0, c1, sim->fb_scale + c0); /* [q - c0] */
-      }
+      for (int ch = 0; ch < nchunk; ++ch) fbar_gather_chunk(sim, id, ch, nblk, n);
     }
 #pragma omp for schedule(static)
     for (int ch = 0; ch < nchunk; ++ch) {
-      const int b0 = ch * J2_CHUNK, b1 = b0 + J2_CHUNK < nblk ? b0 + J2_CHUNK : nblk;
+      const int b0 = ch * MPMC_BLOCK_CHUNK;
+      const int b1 = b0 + MPMC_BLOCK_CHUNK < nblk ? b0 + MPMC_BLOCK_CHUNK : nblk;
       const int c0 = 4 * b0;
       const double *scale = gather ? sim->fb_scale + c0 : NULL; /* [q - c0] */
       for (int blk = b0; blk < b1; ++blk) {
@@ -207,8 +203,8 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
         norm2_4(e, &q2);
         q2 *= 1.5;
         /* J = sqrt(det b) = exp(tr eps), without the exp */
-        const v4 detb = bt[0] * (bt[1] * bt[2] - bt[3] * bt[3]) - bt[5] * (bt[5] * bt[2] - bt[3] * bt[4]) +
-                        bt[4] * (bt[5] * bt[3] - bt[1] * bt[4]);
+        v4 detb;
+        det_sym4(bt, &detb);
         /* elastic lanes finish here (the rest: todo); with the auto solver the plastic ones go
          * on together (plastic4, pl), the others and any plastic4 hands back one by one; the
          * lanes' cases as masks */
