@@ -153,21 +153,14 @@ static inline void norm2_4(const v4 *s, v4 *r) {
 }
 
 /* The block's Hencky strain eps = 1/2 ln b (the trial b of Hencky-J2, the b of Hencky) by
- * linalg.h's series, mpmc_sym3_log_series' operations lane by lane (same tables and Horner
- * scheme), at the degree the largest active lane (mask am) needs.  fail: the lanes whose
+ * linalg.h's series, mpmc_sym3_log_series' operations lane by lane (its macros
+ * MPMC_SYM3_CAYLEY and MPMC_SYM3_ATANH_HORNER), at the degree the largest active lane (mask
+ * am) needs.  fail: the lanes whose
  * strain the series cannot take (|Z|^2 above the table, or not finite). */
 static inline void sym_log_series4(const v4 *b, const l4 *am, v4 *eps, l4 *fail) {
-  const double *rho2_max = mpmc_atanh_rho2_max, *c = mpmc_atanh_c;
-  const v4 a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
-  const v4 m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
-  const v4 adj[6] = {m[1] * m[2] - m[3] * m[3], m[0] * m[2] - m[4] * m[4],
-                     m[0] * m[1] - m[5] * m[5], m[4] * m[5] - m[0] * m[3],
-                     m[5] * m[3] - m[1] * m[4], m[4] * m[3] - m[2] * m[5]};
-  const v4 det = m[0] * adj[0] + m[5] * adj[5] + m[4] * adj[4];
-  v4 z[6], w[6], p[6];
-  sym_mul4(a, adj, z);
-  const v4 inv_det = 1.0 / det;
-  for (int k = 0; k < 6; ++k) z[k] *= inv_det;
+  const double *rho2_max = mpmc_atanh_rho2_max;
+  v4 z[6];
+  MPMC_SYM3_CAYLEY(v4, sym_mul4, b, z);
   v4 r2;
   norm2_4(z, &r2);
   /* fail: |Z|^2 beyond the table or not finite; the degree: that of the largest other lane */
@@ -180,14 +173,7 @@ static inline void sym_log_series4(const v4 *b, const l4 *am, v4 *eps, l4 *fail)
     for (int k = 0; k < 6; ++k) eps[k] = z[k];
     return;
   }
-  sym_mul4(z, z, w);
-  for (int k = 0; k < 6; ++k) p[k] = c[n - 1] * w[k];
-  for (int k = 0; k < 3; ++k) p[k] += c[n - 2];
-  for (int j = n - 3; j >= 0; --j) {
-    sym_mul4(w, p, p);
-    for (int k = 0; k < 3; ++k) p[k] += c[j];
-  }
-  sym_mul4(z, p, eps);
+  MPMC_SYM3_ATANH_HORNER(v4, sym_mul4, z, n, eps);
 }
 
 #endif

@@ -145,18 +145,39 @@ static const double mpmc_atanh_rho2_max[11] = {0.0,        1.665e-16,  1.666e-08
                                                1.3216e-02, 2.1619e-02, 3.2007e-02};
 static const double mpmc_atanh_c[10] = {1.0,        1.0 / 3.0,  1.0 / 5.0,  1.0 / 7.0,  1.0 / 9.0,
                                         1.0 / 11.0, 1.0 / 13.0, 1.0 / 15.0, 1.0 / 17.0, 1.0 / 19.0};
+/* The series' two halves, written once for scalars (T double, MUL mpmc_sym3_mul) and for
+ * batch4.h's four lanes (T v4, MUL sym_mul4), so that both do the same operations:
+ * Z = (b - I)(b + I)^-1 = (b - I) adj(b + I) / det(b + I) into z[6], and, for n >= 2 terms,
+ * eps = Z p(W) by Horner in W = Z^2: p = c_{n-1} W + c_{n-2} I, then p <- W p + c_k I. */
+#define MPMC_SYM3_CAYLEY(T, MUL, b, z)                                                   \
+  do {                                                                                   \
+    const T a_[6] = {(b)[0] - 1.0, (b)[1] - 1.0, (b)[2] - 1.0, (b)[3], (b)[4], (b)[5]};  \
+    const T m_[6] = {(b)[0] + 1.0, (b)[1] + 1.0, (b)[2] + 1.0, (b)[3], (b)[4], (b)[5]};  \
+    const T adj_[6] = {m_[1] * m_[2] - m_[3] * m_[3], m_[0] * m_[2] - m_[4] * m_[4],     \
+                       m_[0] * m_[1] - m_[5] * m_[5], m_[4] * m_[5] - m_[0] * m_[3],     \
+                       m_[5] * m_[3] - m_[1] * m_[4], m_[4] * m_[3] - m_[2] * m_[5]};    \
+    const T det_ = m_[0] * adj_[0] + m_[5] * adj_[5] + m_[4] * adj_[4];                  \
+    MUL(a_, adj_, (z));                                                                  \
+    const T inv_det_ = 1.0 / det_;                                                       \
+    for (int k_ = 0; k_ < 6; ++k_) (z)[k_] *= inv_det_;                                  \
+  } while (0)
+#define MPMC_SYM3_ATANH_HORNER(T, MUL, z, n, eps)                                        \
+  do {                                                                                   \
+    const double *c_ = mpmc_atanh_c;                                                     \
+    T w_[6], p_[6];                                                                      \
+    MUL((z), (z), w_);                                                                   \
+    for (int k_ = 0; k_ < 6; ++k_) p_[k_] = c_[(n) - 1] * w_[k_];                        \
+    for (int k_ = 0; k_ < 3; ++k_) p_[k_] += c_[(n) - 2];                                \
+    for (int j_ = (n) - 3; j_ >= 0; --j_) {                                              \
+      MUL(w_, p_, p_);                                                                   \
+      for (int k_ = 0; k_ < 3; ++k_) p_[k_] += c_[j_];                                   \
+    }                                                                                    \
+    MUL((z), p_, (eps));                                                                 \
+  } while (0)
 static inline int mpmc_sym3_log_series(const double *b, double *eps) {
-  const double *rho2_max = mpmc_atanh_rho2_max, *c = mpmc_atanh_c;
-  const double a[6] = {b[0] - 1.0, b[1] - 1.0, b[2] - 1.0, b[3], b[4], b[5]};
-  const double m[6] = {b[0] + 1.0, b[1] + 1.0, b[2] + 1.0, b[3], b[4], b[5]};
-  const double adj[6] = {m[1] * m[2] - m[3] * m[3], m[0] * m[2] - m[4] * m[4],
-                         m[0] * m[1] - m[5] * m[5], m[4] * m[5] - m[0] * m[3],
-                         m[5] * m[3] - m[1] * m[4], m[4] * m[3] - m[2] * m[5]};
-  const double det = m[0] * adj[0] + m[5] * adj[5] + m[4] * adj[4];
-  double z[6], w[6], p[6];
-  mpmc_sym3_mul(a, adj, z);
-  const double inv_det = 1.0 / det;
-  for (int k = 0; k < 6; ++k) z[k] *= inv_det;
+  const double *rho2_max = mpmc_atanh_rho2_max;
+  double z[6];
+  MPMC_SYM3_CAYLEY(double, mpmc_sym3_mul, b, z);
   const double r2 = mpmc_sym3_norm2(z);
   if (!(r2 <= rho2_max[10])) return 1; /* also NaN, Inf */
   int n = 1;
@@ -165,15 +186,7 @@ static inline int mpmc_sym3_log_series(const double *b, double *eps) {
     for (int k = 0; k < 6; ++k) eps[k] = z[k];
     return 0;
   }
-  mpmc_sym3_mul(z, z, w);
-  /* Horner in W = Z^2: p = c_{n-1} W + c_{n-2} I, then p <- W p + c_k I */
-  for (int k = 0; k < 6; ++k) p[k] = c[n - 1] * w[k];
-  for (int k = 0; k < 3; ++k) p[k] += c[n - 2];
-  for (int j = n - 3; j >= 0; --j) {
-    mpmc_sym3_mul(w, p, p);
-    for (int k = 0; k < 3; ++k) p[k] += c[j];
-  }
-  mpmc_sym3_mul(z, p, eps);
+  MPMC_SYM3_ATANH_HORNER(double, mpmc_sym3_mul, z, n, eps);
   return 0;
 }
 
