@@ -33,8 +33,6 @@ static mpmc_sim make(mpmc_context ctx, int dim, int basis, int mode, int ncell, 
   TCALL(mpmc_sim_prepare(sim));
   mpmc_grid_clear(&sim->grid, 1);
   TCALL(mpmc_slabs_build(sim)); /* the projection scatters by the slabs P2G builds */
-  /* the projection reads x (weights at x^n) and swaps in xn: keep them equal */
-  for (int i = 0; i < *n * dim; ++i) sim->p.xn[i] = sim->p.x[i];
   return sim;
 }
 

@@ -207,8 +207,7 @@ int mpmc_sim_get_num_particles(const mpmc_sim sim, int *n);
  * does not have (e.g. EPS_P without a plastic material) are MPMC_ERR_STATE.  The pointer
  * stays the field across steps and sorts until points are added (the arrays may move).
  * While the velocity is on loan (until its restore) the stability limit of each step takes a
- * pass over the points for max |v| instead of the one G2P found; while the positions are,
- * each F-bar step copies them into the borrowed array (its phase swaps two arrays). */
+ * pass over the points for max |v| instead of the one G2P found. */
 int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp);
 int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data);
 int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids);

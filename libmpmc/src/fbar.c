@@ -16,9 +16,10 @@
  * the points at x^n and, but in the stable form, the weights at hand: in the paper and total
  * forms P2G adds V_i to the node records (slot MPMC_VSLOT, beside the mass) and G2P (V J)_i to
  * fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P sets
- * grid.fb_done.  Called on its own (tests) the projection scatters here, recovering V_p as
- * V0 J^{n+1} / dJ (G2P has already updated J).  The scatter leaves Jbar^n dJ in Jbar for
- * the gather, which replaces it with Pi.
+ * grid.fb_done and leaves x^n in xn (the points have moved by then): the gather reads it.
+ * Called on its own (tests) the projection scatters here and gathers, both at x,
+ * recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter leaves
+ * Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
  * Touches nothing but dF (handed to the material), Jbar, the grid's fb and fbj and the
  * records' MPMC_VSLOT. */
 #include <math.h>
@@ -336,9 +337,9 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
  * updates' chunks: batch4.h, fbar_gather_chunk) */
 #define GATHER_CHUNK 256
 
-/* The F-bar phase's gather (ST: the stable form's): every point's, GATHER_CHUNK at a time,
- * its dF scaled in place (x^n still in x); in the kernels' macro, so that ST reaches the
- * OpenMP region as a constant (transfer.h, MPMC_KERNELS) */
+/* The F-bar phase's gather (ST: the stable form's): every point's, at positions xs (x^n),
+ * GATHER_CHUNK at a time, its dF scaled in place; in the kernels' macro, so that ST reaches
+ * the OpenMP region as a constant (transfer.h, MPMC_KERNELS) */
 #define GATHER_CHUNKS(D, B, ST)                                                              \
   do {                                                                                       \
     const int n = sim->p.n, nch = (n + GATHER_CHUNK - 1) / GATHER_CHUNK;                     \
@@ -346,7 +347,7 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
     for (int ch = 0; ch < nch; ++ch) {                                                       \
       const int q0 = ch * GATHER_CHUNK, q1 = q0 + GATHER_CHUNK < n ? q0 + GATHER_CHUNK : n;  \
       double scale[GATHER_CHUNK];                                                            \
-      gather_points(sim, D, B, ST, sim->p.x, -1, q0, q1, scale);                             \
+      gather_points(sim, D, B, ST, xs, -1, q0, q1, scale);                                   \
       for (int q = q0; q < q1; ++q) scale_dF(&sim->p, D, q, scale[q - q0]);                  \
     }                                                                                        \
   } while (0)
@@ -361,8 +362,10 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
         for (int k = start[sl]; k < start[sl + 1]; ++k) scatter_point(sim, D, B, order[k]);  \
     }                                                                                        \
   }                                                                                          \
-  static void gather_##D##_##B(mpmc_sim sim) { GATHER_CHUNKS(D, B, 0); }                     \
-  static void gather_stable_##D##_##B(mpmc_sim sim) { GATHER_CHUNKS(D, B, 1); }              \
+  static void gather_##D##_##B(mpmc_sim sim, const double *xs) { GATHER_CHUNKS(D, B, 0); }   \
+  static void gather_stable_##D##_##B(mpmc_sim sim, const double *xs) {                      \
+    GATHER_CHUNKS(D, B, 1);                                                                  \
+  }                                                                                          \
   /* the deferred gather of points q0 .. q1 - 1 of material id (x^n in xn by then) */        \
   static void gather_range_##D##_##B(mpmc_sim sim, int id, int q0, int q1, double *scale) {  \
     if (sim->fbar == MPMC_FBAR_STABLE)                                                       \
@@ -397,6 +400,7 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   mpmc_grid *g = &sim->grid;
   const int stable = sim->fbar == MPMC_FBAR_STABLE;
   for (int m = 0; m < sim->nmat && defer; ++m) defer = sim->mats[m].ops->gathers_fbar;
+  const double *xs = g->fb_done ? sim->p.xn : sim->p.x; /* x^n: G2P has moved the points */
   if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
     mpmc_grid_clear_fb_active(g);
     if (stable)
@@ -437,13 +441,9 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   if (defer)
     ; /* the material update gathers, from xn (mpmc_fbar_gather_range), into sim->fb_scale */
   else if (stable)
-    MPMC_KERNEL_CALL(gather_stable_, sim, sim);
+    MPMC_KERNEL_CALL(gather_stable_, sim, sim, xs);
   else
-    MPMC_KERNEL_CALL(gather_, sim, sim);
-  /* the projection used the weights at x^n; now the points move (eq 17) */
-  double *t = sim->p.x;
-  sim->p.x = sim->p.xn;
-  sim->p.xn = t;
+    MPMC_KERNEL_CALL(gather_, sim, sim, xs);
   return MPMC_SUCCESS;
 }
 

@@ -1,8 +1,9 @@
 /* Grid to particle: velocity with the FLIP/PIC blend (eqs 11-13), relative deformation
  * gradient dF = 1 + dt sum v_i (x) grad w (eq 16), J <- J det(dF) so that V = J V0 (eq 15),
- * position (eq 17).  With F-bar the new positions go to xn: the projection still needs the
- * weights at x^n; its scatter (fbar.c) is fused in here, where those weights are at hand (in
- * the paper and total forms only of V^n j: P2G scattered V^n, p2g.c). */
+ * position (eq 17), in place.  With F-bar the old positions go to xn as well: the
+ * projection's gather, in the material update, still needs the weights at x^n; its scatter
+ * (fbar.c) is fused in here, where those weights are at hand (in the paper and total forms
+ * only of V^n j: P2G scattered V^n, p2g.c). */
 #include <limits.h>
 #include <math.h>
 
@@ -13,7 +14,7 @@
 
 typedef struct {
   double eta;             /* FLIP/PIC blend                                             */
-  double *xout;           /* new positions: x, or xn while F-bar needs x^n              */
+  double *xold;           /* with F-bar xn, which gets x^n for the gather; else NULL    */
   double xmin[3], xmax[3];/* points may drift up to one cell beyond the box (walls act on
                              the nodes there); further out the support leaves the grid   */
 } g2p_ctx;
@@ -186,14 +187,15 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     dv[i] = A[sf / MPMC_VW][sf % MPMC_VW];
   }
   double *v = p->v + qd;
-  const double eta = c->eta, pic = 1.0 - eta; /* in registers: v and xout might alias c */
+  const double eta = c->eta, pic = 1.0 - eta; /* in registers: v and xold might alias c */
   double v2 = 0.0; /* |v|^2 summed as stability.c's pass sums it */
   for (int a = 0; a < DIM; ++a) {
     const double va = eta * (v[a] + dv[a]) + pic * vpic[a];
     v[a] = va;
     v2 += va * va;
-    const double xa = p->x[qd + a] + dt * vpic[a];
-    c->xout[qd + a] = xa;
+    const double x0 = p->x[qd + a], xa = x0 + dt * vpic[a];
+    if (FB) c->xold[qd + a] = x0;
+    p->x[qd + a] = xa;
     ok &= (xa >= c->xmin[a]) & (xa <= c->xmax[a]);
   }
   *v2max = v2 > *v2max ? v2 : *v2max; /* NaN skipped, as there */
@@ -272,7 +274,7 @@ MPMC_KERNELS(G2P_KERNEL)
 static int report(mpmc_sim sim, int q) {
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim;
-  const double *x = (sim->fbar ? p->xn : p->x) + (size_t)q * d;
+  const double *x = p->x + (size_t)q * d; /* where it went */
   const double *dF = p->dF + (size_t)q * d * d;
   const double dJ = d == 2 ? mpmc_det_dim(2, dF) : mpmc_det_dim(3, dF);
   char nb[MPMC_POINT_NAME_LEN];
@@ -291,7 +293,7 @@ static int report(mpmc_sim sim, int q) {
 /** Phase 3 of the step. */
 int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   const mpmc_grid *g = &sim->grid;
-  g2p_ctx c = {.eta = sim->flip, .xout = sim->fbar ? sim->p.xn : sim->p.x};
+  g2p_ctx c = {.eta = sim->flip, .xold = sim->fbar ? sim->p.xn : NULL};
   for (int a = 0; a < sim->dim; ++a) {
     c.xmin[a] = g->lo[a] - g->h;
     c.xmax[a] = g->hi[a] + g->h;

@@ -75,7 +75,7 @@ typedef struct {
                     mpmc_sim_get_particle_ids; NULL: ids are the indices) (sort.c)      */
   /* step scratch */
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
-  double *xn;    /* [n][dim] new positions while F-bar still needs the old ones    */
+  double *xn;    /* [n][dim] with F-bar x^n, from G2P (which moves x) to the gather */
 } mpmc_particles;
 
 /* A point's name in error messages: its index, and its id (the index it was added with)
@@ -329,9 +329,6 @@ struct mpmc_sim_s {
    * until mpmc_sim_restore_field: both clear it) */
   double v2max;
   int v2max_ok, v_borrowed;
-  /* the position array as a caller borrowed it (mpmc_sim_get_field, until its restore):
-   * F-bar's phase swaps x and xn, so the step copies the new positions back into it */
-  double *x_lent;
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),

@@ -328,7 +328,6 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
   }
   int cap = p->cap ? p->cap : 64;
   while (cap < p->n + n) cap = cap > INT32_MAX / 2 ? INT32_MAX : 2 * cap;
-  sim->x_lent = NULL; /* the arrays may move: a borrowed pointer is void (mpmc.h) */
   MPMC_CALL(mpmc_particles_reserve(ctx, p, cap));
   const mpmc_material *m = &sim->mats[material];
   const int n0 = p->n;
@@ -447,7 +446,6 @@ int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   if (!*f && sim->grid.valid) MPMC_CALL(mpmc_sim_prepare(sim));
   MPMC_CHECK(*f, sim->ctx, MPMC_ERR_STATE, "this simulation has no '%s' field", field_names[field]);
   if (field == MPMC_FIELD_VELOCITY) sim->v_borrowed = 1, sim->v2max_ok = 0; /* G2P's max |v| no longer holds */
-  if (field == MPMC_FIELD_POSITION) sim->x_lent = *f;    /* kept in place by the step    */
   *data = *f;
   if (ncomp) *ncomp = nc;
   return MPMC_SUCCESS;
@@ -459,7 +457,6 @@ int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data) {
   MPMC_CHECK(field >= 0 && field < MPMC_FIELD_COUNT, sim->ctx, MPMC_ERR_ARG,
              "field = %d is not a particle field", field);
   if (data) *data = NULL;
-  if (field == MPMC_FIELD_POSITION) sim->x_lent = NULL;
   if (field == MPMC_FIELD_VELOCITY) { /* the caller may have written v: a pass until G2P's next */
     sim->v_borrowed = 0;
     sim->v2max_ok = 0;

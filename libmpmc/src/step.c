@@ -3,7 +3,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-#include <string.h>
 #include <time.h>
 
 #include "mpmc_impl.h"
@@ -132,15 +131,6 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   if (!err) err = mpmc_sort_due(sim); /* locality: points by cell (sort.c), if asked for */
   lap(sim, MPMC_PHASE_SORT, &t);
   if (!err) err = step_phases(sim, dt, &t);
-  /* F-bar's phase swaps x and xn (fbar.c): a position array on loan to the caller
-   * (mpmc_sim_get_field) gets the new positions back and stays the positions, also after a
-   * failed step; only then is there a copy */
-  if (sim->x_lent && sim->x_lent == sim->p.xn) {
-    memcpy(sim->p.xn, sim->p.x, sizeof(double) * (size_t)sim->p.n * (size_t)sim->dim);
-    sim->p.xn = sim->p.x;
-    sim->p.x = sim->x_lent;
-    lap(sim, MPMC_PHASE_FBAR, &t);
-  }
   if (sim->bodies) mpmc_contact_step(sim, 0);
 #ifdef _OPENMP
   if (sim->nthreads > 0) omp_set_num_threads(saved);
