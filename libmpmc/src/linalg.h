@@ -227,6 +227,20 @@ static const double mpmc_exp_c[17] = {
     1.0 / 3628800.0, 1.0 / 39916800.0, 1.0 / 479001600.0, 1.0 / 6227020800.0,
     1.0 / 87178291200.0, 1.0 / 1307674368000.0, 1.0 / 20922789888000.0};
 
+/* p = the Taylor series of exp(M) to M^n / n! in Horner form, M symmetric (Voigt) of type T
+ * (double, or batch4.h's four lanes) and MUL its symmetric product: p = c_n M + c_{n-1} I,
+ * then p <- M p + c_k I down to k = 0 (mpmc_sym3_exp_series, stress_j2.c's plastic lanes) */
+#define MPMC_SYM3_EXP_HORNER(T, MUL, M, n, p)                                            \
+  do {                                                                                   \
+    const double *c_ = mpmc_exp_c;                                                       \
+    for (int k_ = 0; k_ < 6; ++k_) (p)[k_] = c_[(n)] * (M)[k_];                          \
+    for (int k_ = 0; k_ < 3; ++k_) (p)[k_] += c_[(n) - 1];                               \
+    for (int j_ = (n) - 2; j_ >= 0; --j_) {                                              \
+      MUL((M), (p), (p));                                                                \
+      for (int k_ = 0; k_ < 3; ++k_) (p)[k_] += c_[j_];                                  \
+    }                                                                                    \
+  } while (0)
+
 /* E = exp(M) of a symmetric M (Voigt) of small norm by its Taylor series in Horner form
  * (the returned b_e = exp(2 eps) of a plastic point on the fast path).  With rho = |M|_F the
  * tail after M^n / n! is below rho^(n+1) / (n+1)! e^rho, and E's smallest eigenvalue is
@@ -234,19 +248,13 @@ static const double mpmc_exp_c[17] = {
  * that makes this <= 2^-54 (the table holds the largest rho^2 for each n).
  * Returns 0, or 1 when |M|_F > 0.728 or M is not finite. */
 static inline int mpmc_sym3_exp_series(const double *M, double *E) {
-  const double *rho2_max = mpmc_exp_rho2_max, *c = mpmc_exp_c;
+  const double *rho2_max = mpmc_exp_rho2_max;
   const double r2 = mpmc_sym3_norm2(M);
   if (!(r2 <= rho2_max[16])) return 1;
   int n = 1;
   while (r2 > rho2_max[n]) ++n;
   double p[6];
-  /* p = c_n M + c_{n-1} I, then p <- M p + c_k I down to k = 0 */
-  for (int k = 0; k < 6; ++k) p[k] = c[n] * M[k];
-  for (int k = 0; k < 3; ++k) p[k] += c[n - 1];
-  for (int j = n - 2; j >= 0; --j) {
-    mpmc_sym3_mul(M, p, p);
-    for (int k = 0; k < 3; ++k) p[k] += c[j];
-  }
+  MPMC_SYM3_EXP_HORNER(double, mpmc_sym3_mul, M, n, p);
   for (int k = 0; k < 6; ++k) E[k] = p[k];
   return 0;
 }

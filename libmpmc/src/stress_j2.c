@@ -93,14 +93,8 @@ static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, c
   while (rmax > mpmc_exp_rho2_max[n]) ++n;
   if (!any) return;
   /* exp(en) as mpmc_sym3_exp_series, then b_e = b exp(en) */
-  const double *cf = mpmc_exp_c;
   v4 p[6];
-  for (int k = 0; k < 6; ++k) p[k] = cf[n] * en[k];
-  for (int k = 0; k < 3; ++k) p[k] += cf[n - 1];
-  for (int j = n - 2; j >= 0; --j) {
-    sym_mul4(en, p, p);
-    for (int k = 0; k < 3; ++k) p[k] += cf[j];
-  }
+  MPMC_SYM3_EXP_HORNER(v4, sym_mul4, en, n, p);
   sym_mul4(bt, p, be);
   for (int k = 0; k < 6; ++k) es[k] = e[k] * f;
 }
