@@ -18,7 +18,8 @@
  * share is rate(off) / rate(on) - 1 of its adjacent pair (the machine's drift, slow against a
  * round, cancels in a pair).  Printed per form: the median and range of the R shares; the
  * share from the best rate of each (the runs least disturbed by other load, on a busy host
- * the steadier figure); each phase's least ms a step over the rounds, off and on. */
+ * the steadier figure); each phase's least ms a step over the rounds, off and on, and their
+ * sums' ratio (each phase at its least disturbed round). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -188,7 +189,13 @@ static void fbar_shares(int rounds, int steps, double scale) {
       if (least[f][1][k] > 0.0005)
         printf(" %s %.3f -> %.3f", k < MPMC_PHASE_COUNT ? mpmc_phase_name(k) : "step",
                least[f][0][k], least[f][1][k]);
-    printf("\n");
+    /* the sums of the phases' least times: each phase at its least disturbed round, off and
+     * on alike (both sums below any one round's step) */
+    double sum[2] = {0.0, 0.0};
+    for (int o = 0; o < 2; ++o)
+      for (int k = 0; k < MPMC_PHASE_COUNT; ++k) sum[o] += least[f][o][k];
+    printf("\n    the phases' least times summed: %.3f -> %.3f ms, %+6.1f %%\n", sum[0], sum[1],
+           100 * (sum[1] / sum[0] - 1.0));
   }
   free(sh);
 }
