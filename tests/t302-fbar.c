@@ -5,7 +5,8 @@
  * the projection onto the basis itself (total form) passes at a large share of its amplitude:
  * the pressure checkerboard of the strip footing (docs/theory.md).  A caller that borrows the
  * positions once and keeps the pointer across F-bar steps (a legacy Fortran loop) reads the
- * current positions through it, the same bits as a run that borrows them afresh. */
+ * current positions through it, the same bits as a run that borrows them afresh.  In a step
+ * the projection's weights are those at x^n, before G2P moves the points. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "basis.h"
 #include "mpmc_impl.h"
 #include "test_util.h"
 
@@ -529,6 +531,69 @@ static void test_deferred_gather(void **state) {
       }
 }
 
+/* Point q's sum_i w_i(x) Jbar_i over the grid's nodal averages fbj (the paper and total
+ * forms' space, the basis itself), at the positions xs, axis by axis as the 1D weights. */
+static double projected_at(const mpmc_sim sim, const double *xs, int q) {
+  const mpmc_grid *g = &sim->grid;
+  const int d = sim->dim, basis = sim->basis, S = mpmc_stencil(basis);
+  double w[3][MPMC_MAX_STENCIL] = {{0}}, dw[MPMC_MAX_STENCIL];
+  int base[3] = {0, 0, 0};
+  for (int a = 0; a < d; ++a)
+    mpmc_basis_1d(basis, (xs[(size_t)q * d + a] - g->origin[a]) * g->inv_h,
+                  basis == MPMC_BASIS_UGIMP ? sim->p.lp[q] * g->inv_h : 0.0, g->inv_h, &base[a],
+                  w[a], dw);
+  const size_t sy = (size_t)g->n[0], sz = sy * (size_t)g->n[1];
+  const size_t node0 = (size_t)base[0] + sy * (size_t)base[1] + (d == 3 ? sz * (size_t)base[2] : 0);
+  double pi = 0.0;
+  for (int k = 0; k < (d == 3 ? S : 1); ++k)
+    for (int j = 0; j < S; ++j)
+      for (int i = 0; i < S; ++i)
+        pi += w[0][i] * w[1][j] * (d == 3 ? w[2][k] : 1.0) *
+              g->fbj[node0 + (size_t)i + sy * (size_t)j + sz * (size_t)k];
+  return pi;
+}
+
+/* Algorithm 1 projects with the weights at x^n (G2P moves the points, and keeps x^n for the
+ * gather): after a step of the slump, every point's projected Jacobian (Jbar) is the sum of
+ * the nodal averages with its weights at the positions before the step, not after it; the
+ * paper and total forms, every basis, 2D and 3D, one and two threads. */
+static void test_gather_at_xn(void **state) {
+  (void)state;
+  for (int dim = 2; dim <= 3; ++dim)
+    for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_TOTAL; ++form)
+      for (int b = 0; b < 4; ++b)
+        for (int threads = 1; threads <= 2; ++threads) {
+          mpmc_context ctx;
+          TCALL(mpmc_context_create(&ctx));
+          test_ctx = ctx;
+          mpmc_sim sim = slump(ctx, dim, b, form, 0, 0, SLUMP_HENCKY);
+          TCALL(mpmc_sim_set_threads(sim, threads));
+          const int n = sim->p.n;
+          double *xn = malloc(sizeof(double) * (size_t)n * (size_t)dim), dt;
+          assert_non_null(xn);
+          memcpy(xn, sim->p.x, sizeof(double) * (size_t)n * (size_t)dim);
+          TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
+          TCALL(mpmc_sim_step(sim, dt));
+          double worst = 0.0, moved = 0.0;
+          for (int q = 0; q < n; ++q) {
+            const double e = fabs(projected_at(sim, xn, q) - sim->p.Jbar[q]);
+            worst = e > worst ? e : worst;
+            const double m = fabs(projected_at(sim, sim->p.x, q) - sim->p.Jbar[q]);
+            moved = m > moved ? m : moved;
+          }
+          if (!(worst <= 1e-13))
+            fail_msg("dim %d form %d basis %d, %d threads: Jbar differs from the projection at "
+                     "x^n by %.3g", dim, form, b, threads, worst);
+          if (!(moved > 1e-9))
+            fail_msg("dim %d form %d basis %d: the projection at x^{n+1} is within %.3g of the "
+                     "one at x^n: the test no longer tells them apart", dim, form, b, moved);
+          free(xn);
+          mpmc_sim_destroy(&sim);
+          mpmc_context_destroy(&ctx);
+          test_ctx = NULL;
+        }
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_homogeneous),
@@ -539,6 +604,7 @@ int main(void) {
       cmocka_unit_test(test_row_ranges_mirrors),
       cmocka_unit_test(test_deferred_gather),
       cmocka_unit_test(test_positions_held),
+      cmocka_unit_test(test_gather_at_xn),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }
