@@ -14,8 +14,8 @@
 
 #include <cmocka.h>
 
-#include "basis.h"
 #include "mpmc_impl.h"
+#include "transfer.h"
 #include "test_util.h"
 
 static mpmc_sim make(mpmc_context ctx, int dim, int basis, int mode, int ncell, double **x, int *n) {
@@ -531,11 +531,19 @@ static void test_deferred_gather(void **state) {
       }
 }
 
-/* Point q's sum_i w_i(x) Jbar_i over the grid's nodal averages fbj (the paper and total
- * forms' space, the basis itself), at the positions xs, axis by axis as the 1D weights. */
+/* Point q's sum_i w_i(x) Jbar_i over the grid's nodal averages fbj at the positions xs: with
+ * the weights of the stable form's space (transfer.h), or of the basis itself (the paper and
+ * total forms), axis by axis as the 1D weights. */
 static double projected_at(const mpmc_sim sim, const double *xs, int q) {
   const mpmc_grid *g = &sim->grid;
   const int d = sim->dim, basis = sim->basis, S = mpmc_stencil(basis);
+  if (sim->fbar == MPMC_FBAR_STABLE) {
+    mpmc_spw sp;
+    mpmc_stable_weights(d, basis, g, xs + (size_t)q * d, &sp);
+    double pi = 0.0;
+    MPMC_STABLE_LOOP(d, basis, sp, { pi += w * g->fbj[node]; });
+    return pi;
+  }
   double w[3][MPMC_MAX_STENCIL] = {{0}}, dw[MPMC_MAX_STENCIL];
   int base[3] = {0, 0, 0};
   for (int a = 0; a < d; ++a)
@@ -555,12 +563,12 @@ static double projected_at(const mpmc_sim sim, const double *xs, int q) {
 
 /* Algorithm 1 projects with the weights at x^n (G2P moves the points, and keeps x^n for the
  * gather): after a step of the slump, every point's projected Jacobian (Jbar) is the sum of
- * the nodal averages with its weights at the positions before the step, not after it; the
- * paper and total forms, every basis, 2D and 3D, one and two threads. */
+ * the nodal averages with its weights at the positions before the step, not after it; every
+ * form, every basis, 2D and 3D, one and two threads. */
 static void test_gather_at_xn(void **state) {
   (void)state;
   for (int dim = 2; dim <= 3; ++dim)
-    for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_TOTAL; ++form)
+    for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_STABLE; ++form)
       for (int b = 0; b < 4; ++b)
         for (int threads = 1; threads <= 2; ++threads) {
           mpmc_context ctx;
