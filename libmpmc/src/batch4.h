@@ -136,15 +136,7 @@ static inline double max_lane(const v4 *r, const l4 *m) {
 }
 
 /* c = a b for symmetric a, b (Voigt) that commute, as mpmc_sym3_mul */
-static inline void sym_mul4(const v4 *a, const v4 *b, v4 *c) {
-  const v4 xx = a[0] * b[0] + a[5] * b[5] + a[4] * b[4];
-  const v4 yy = a[5] * b[5] + a[1] * b[1] + a[3] * b[3];
-  const v4 zz = a[4] * b[4] + a[3] * b[3] + a[2] * b[2];
-  const v4 yz = a[5] * b[4] + a[1] * b[3] + a[3] * b[2];
-  const v4 xz = a[0] * b[4] + a[5] * b[3] + a[4] * b[2];
-  const v4 xy = a[0] * b[5] + a[5] * b[1] + a[4] * b[3];
-  c[0] = xx, c[1] = yy, c[2] = zz, c[3] = yz, c[4] = xz, c[5] = xy;
-}
+static inline void sym_mul4(const v4 *a, const v4 *b, v4 *c) { MPMC_SYM3_MUL(v4, a, b, c); }
 
 /* |s|^2 (Voigt, tensor shear components), as mpmc_sym3_norm2 (through a pointer: a v4
  * returned by value would change the baseline build's ABI) */

@@ -106,20 +106,20 @@ static inline void mpmc_sym3_compose(const double d[3], double Q[3][3], double *
 }
 
 /* c = a b for symmetric a, b that commute (functions of one tensor), so that a b is
- * symmetric: only its upper triangle is formed (Voigt). */
+ * symmetric: only its upper triangle is formed (Voigt).  Written once for scalars (T double,
+ * mpmc_sym3_mul) and batch4.h's four lanes (T v4, sym_mul4); c may be a or b. */
+#define MPMC_SYM3_MUL(T, a, b, c)                                                        \
+  do {                                                                                   \
+    const T xx_ = (a)[0] * (b)[0] + (a)[5] * (b)[5] + (a)[4] * (b)[4];                   \
+    const T yy_ = (a)[5] * (b)[5] + (a)[1] * (b)[1] + (a)[3] * (b)[3];                   \
+    const T zz_ = (a)[4] * (b)[4] + (a)[3] * (b)[3] + (a)[2] * (b)[2];                   \
+    const T yz_ = (a)[5] * (b)[4] + (a)[1] * (b)[3] + (a)[3] * (b)[2];                   \
+    const T xz_ = (a)[0] * (b)[4] + (a)[5] * (b)[3] + (a)[4] * (b)[2];                   \
+    const T xy_ = (a)[0] * (b)[5] + (a)[5] * (b)[1] + (a)[4] * (b)[3];                   \
+    (c)[0] = xx_, (c)[1] = yy_, (c)[2] = zz_, (c)[3] = yz_, (c)[4] = xz_, (c)[5] = xy_;  \
+  } while (0)
 static inline void mpmc_sym3_mul(const double *a, const double *b, double *c) {
-  const double xx = a[0] * b[0] + a[5] * b[5] + a[4] * b[4];
-  const double yy = a[5] * b[5] + a[1] * b[1] + a[3] * b[3];
-  const double zz = a[4] * b[4] + a[3] * b[3] + a[2] * b[2];
-  const double yz = a[5] * b[4] + a[1] * b[3] + a[3] * b[2];
-  const double xz = a[0] * b[4] + a[5] * b[3] + a[4] * b[2];
-  const double xy = a[0] * b[5] + a[5] * b[1] + a[4] * b[3];
-  c[0] = xx;
-  c[1] = yy;
-  c[2] = zz;
-  c[3] = yz;
-  c[4] = xz;
-  c[5] = xy;
+  MPMC_SYM3_MUL(double, a, b, c);
 }
 
 /* |s|^2 = s : s (Voigt, tensor shear components) */
