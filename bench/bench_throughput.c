@@ -3,7 +3,7 @@
  *   column - the 3D column collapse of issue 6: 2 x 0.5 x 1 m domain, h = 0.025 m, a 0.5 m
  *            cube of J2 soil with 2x2x2 points per cell (64,000 points), gravity
  * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale] [case] [threads] [shuffle] [sort];
- * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-8,
+ * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-9,
  * the rows of the table; -1 all) and threads (1 or 2; 0 both) narrow the run for profiling,
  * e.g. under callgrind; shuffle = 1 stores the points in random order (what sorting the
  * particle arrays by cell undoes: the cost of lost locality); sort = N sorts the points by cell
@@ -13,8 +13,9 @@
  * cost.  With MPMC_BENCH_PHASES set each row is followed by the share of the step's wall time
  * per phase (mpmc_stats.phase_seconds) of its last run.  With MPMC_BENCH_SHARE=R set, the
  * table (none with a case beyond it, e.g. 99) is followed by F-bar's share of the standard
- * step on the column, one thread: the steps without and with each form (B-spline2 and uGIMP,
- * Algorithm 1 and stable) run alternately for R rounds in this one process, and each round's
+ * step on the column, one thread: the steps without and with each form (linear, B-spline2 and
+ * uGIMP with Algorithm 1; B-spline2 and uGIMP with the stable form; the linear basis is the
+ * issue's reference column's) run alternately for R rounds in this one process, and each round's
  * share is rate(off) / rate(on) - 1 of its adjacent pair (the machine's drift, slow against a
  * round, cancels in a pair).  Printed per form: the median and range of the R shares; the
  * share from the best rate of each (the runs least disturbed by other load, on a busy host
@@ -148,7 +149,8 @@ static void fbar_shares(int rounds, int steps, double scale) {
   static const struct {
     int basis, fbar;
     const char *name;
-  } forms[] = {{MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, "bspline2 paper"},
+  } forms[] = {{MPMC_BASIS_LINEAR, MPMC_FBAR_PAPER, "linear paper"},
+               {MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, "bspline2 paper"},
                {MPMC_BASIS_UGIMP, MPMC_FBAR_PAPER, "ugimp paper"},
                {MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, "bspline2 stable"},
                {MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, "ugimp stable"}};
@@ -221,6 +223,8 @@ int main(int argc, char **argv) {
       {1, MPMC_BASIS_UGIMP, 0, 1},    {1, MPMC_BASIS_UGIMP, 1, 1},
       /* the stable form of F-bar (J-bar one order below the basis) */
       {1, MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, 1}, {1, MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, 1},
+      /* the reference column's basis with Algorithm 1 */
+      {1, MPMC_BASIS_LINEAR, MPMC_FBAR_PAPER, 1},
   };
   printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s %7s\n", "scene", "basis", "fbar", "material",
          "points", "1 thread [M/s]", "2 threads [M/s]", "speedup", "B/point");
