@@ -83,10 +83,7 @@ static inline void load_dF4(const int d, const double *f, const v4 *scp, v4 *F) 
 
 /* det b of symmetric b (Voigt) per lane, in mpmc_det_sym's order (linalg.h), so the same bits
  * per lane (through a pointer, as sqrt4) */
-static inline void det_sym4(const v4 *b, v4 *r) {
-  *r = b[0] * (b[1] * b[2] - b[3] * b[3]) - b[5] * (b[5] * b[2] - b[3] * b[4]) +
-       b[4] * (b[5] * b[3] - b[1] * b[4]);
-}
+static inline void det_sym4(const v4 *b, v4 *r) { *r = MPMC_DET_SYM(b); }
 
 /* blocks of four that the batched updates hand to a thread at a time (stress_j2.c,
  * stress_blocks.c), also the chunks of F-bar's deferred gather */

@@ -52,10 +52,12 @@ static inline double mpmc_det3(double A[3][3]) {
          A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
 }
 
-static inline double mpmc_det_sym(const double *s) {
-  return s[0] * (s[1] * s[2] - s[3] * s[3]) - s[5] * (s[5] * s[2] - s[3] * s[4]) +
-         s[4] * (s[5] * s[3] - s[1] * s[4]);
-}
+/* det s of a symmetric s (Voigt), written once for scalars (mpmc_det_sym) and batch4.h's four
+ * lanes (det_sym4), so that both take the same operations in the same order */
+#define MPMC_DET_SYM(s)                                                                  \
+  ((s)[0] * ((s)[1] * (s)[2] - (s)[3] * (s)[3]) -                                        \
+   (s)[5] * ((s)[5] * (s)[2] - (s)[3] * (s)[4]) + (s)[4] * ((s)[5] * (s)[3] - (s)[1] * (s)[4]))
+static inline double mpmc_det_sym(const double *s) { return MPMC_DET_SYM(s); }
 
 /* Eigen-decomposition of a symmetric 3x3 tensor (Voigt s): s = sum_a lam[a] q_a q_a^T with
  * q_a the column a of Q.  Cyclic Jacobi; converges quadratically, ~3-5 sweeps. */
@@ -227,10 +229,10 @@ static const double mpmc_exp_c[17] = {
     1.0 / 3628800.0, 1.0 / 39916800.0, 1.0 / 479001600.0, 1.0 / 6227020800.0,
     1.0 / 87178291200.0, 1.0 / 1307674368000.0, 1.0 / 20922789888000.0};
 
-/* p = the Taylor series of exp(M) to M^n / n! in Horner form, M symmetric (Voigt) of type T
- * (double, or batch4.h's four lanes) and MUL its symmetric product: p = c_n M + c_{n-1} I,
+/* p = the Taylor series of exp(M) to M^n / n! in Horner form, M symmetric (Voigt) of
+ * doubles or batch4.h's four lanes and MUL its symmetric product: p = c_n M + c_{n-1} I,
  * then p <- M p + c_k I down to k = 0 (mpmc_sym3_exp_series, stress_j2.c's plastic lanes) */
-#define MPMC_SYM3_EXP_HORNER(T, MUL, M, n, p)                                            \
+#define MPMC_SYM3_EXP_HORNER(MUL, M, n, p)                                               \
   do {                                                                                   \
     const double *c_ = mpmc_exp_c;                                                       \
     for (int k_ = 0; k_ < 6; ++k_) (p)[k_] = c_[(n)] * (M)[k_];                          \
@@ -254,7 +256,7 @@ static inline int mpmc_sym3_exp_series(const double *M, double *E) {
   int n = 1;
   while (r2 > rho2_max[n]) ++n;
   double p[6];
-  MPMC_SYM3_EXP_HORNER(double, mpmc_sym3_mul, M, n, p);
+  MPMC_SYM3_EXP_HORNER(mpmc_sym3_mul, M, n, p);
   for (int k = 0; k < 6; ++k) E[k] = p[k];
   return 0;
 }

@@ -28,7 +28,6 @@
 #include <immintrin.h>
 #endif
 
-
 /* The plastic lanes of a block (mask *pl) returned together, for the auto solver:
  * return_map.c's Newton iteration (solve_newton, strict) lane by lane in vectors -- the
  * same operations in the same order, the branches taken per lane, so each lane gets the
@@ -94,7 +93,7 @@ static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, c
   if (!any) return;
   /* exp(en) as mpmc_sym3_exp_series, then b_e = b exp(en) */
   v4 p[6];
-  MPMC_SYM3_EXP_HORNER(v4, sym_mul4, en, n, p);
+  MPMC_SYM3_EXP_HORNER(sym_mul4, en, n, p);
   sym_mul4(bt, p, be);
   for (int k = 0; k < 6; ++k) es[k] = e[k] * f;
 }
