@@ -3,7 +3,8 @@
  * stress update and the monitor run their parallel loops) stepped on 1 and on 2 threads;
  * positions, velocities, stresses and J agree to round-off (the scatter sums in another
  * order), and neither run trips the monitor; also a compact body, whose threads scatter into
- * grids of their own. */
+ * grids of their own.  Also the slab order P2G builds, the threads' runs of slabs, and G2P's
+ * index-order path. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -263,9 +264,92 @@ static void test_slab_groups(void **state) {
   mpmc_context_destroy(&ctx);
 }
 
+/* G2P's index-order path (sim->order_ident, g2p.c): the slab build flags an order that is
+ * the identity, and only then.  Seeded x fastest, the box's points are not
+ * in the order of its slab axis, x; sorted (the slab axis outermost), they are, on one thread
+ * and on two; a point moved to a plane of its own breaks it.  With the flag on, G2P (F-bar's
+ * scatter too) takes the same sequence as through the order: fbj and the points' x, v, dF and
+ * J to the bit (and P2G's records), the flag cleared by hand for the comparison. */
+static void test_index_order(void **state) {
+  (void)state;
+  mpmc_context ctx;
+  mpmc_sim sim;
+  int mat, n;
+  slab_sim(&ctx, &sim, &mat);
+  TCALL(mpmc_sim_set_fbar(sim, MPMC_FBAR_PAPER));
+  const double bhi[3] = {1.6, 0.7, 0.8}, g[3] = {0.3, -9.81, 0.1};
+  TCALL(mpmc_sim_seed_box(sim, slab_lo, bhi, 2, mat, NULL, &n));
+  TCALL(mpmc_sim_set_gravity(sim, g));
+  TCALL(mpmc_sim_prepare(sim));
+  TCALL(mpmc_slabs_build(sim));
+  if (sim->slab_axis != 0 || sim->order_ident)
+    fail_msg("seeded x fastest: slab axis %d, identity flag %d; expected axis 0 and no identity",
+             sim->slab_axis, sim->order_ident);
+  TCALL(mpmc_sim_sort_particles(sim));
+  const int saved = omp_get_max_threads();
+  for (int nt = 1; nt <= 2; ++nt) {
+    omp_set_num_threads(nt);
+    TCALL(mpmc_slabs_build(sim));
+    if (!sim->order_ident) fail_msg("sorted, %d thread(s): no identity flag", nt);
+    for (int k = 0; k < n; ++k)
+      if (sim->order[k] != k) fail_msg("sorted, %d thread(s): order[%d] = %d", nt, k, sim->order[k]);
+  }
+  omp_set_num_threads(saved);
+  double *v;
+  TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+  for (int k = 0; k < 3 * n; ++k) v[k] = 0.05 * sin(0.37 * k);
+  TCALL(mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
+  mpmc_particles *p = &sim->p;
+  const size_t n3 = 3 * (size_t)n, n9 = 9 * (size_t)n;
+  double *x0 = malloc(sizeof(double) * n3), *v0 = malloc(sizeof(double) * n3);
+  double *J0 = malloc(sizeof(double) * (size_t)n), *Jb0 = malloc(sizeof(double) * (size_t)n);
+  memcpy(x0, p->x, sizeof(double) * n3), memcpy(v0, p->v, sizeof(double) * n3);
+  memcpy(J0, p->J, sizeof(double) * (size_t)n), memcpy(Jb0, p->Jbar, sizeof(double) * (size_t)n);
+  const size_t nrec = sim->grid.nn * MPMC_NREC;
+  double *out[2][6];
+  const size_t len[6] = {nrec, sim->grid.nn, n3, n3, n9, (size_t)n};
+  for (int run = 0; run < 2; ++run) {
+    memcpy(p->x, x0, sizeof(double) * n3), memcpy(p->v, v0, sizeof(double) * n3);
+    memcpy(p->J, J0, sizeof(double) * (size_t)n), memcpy(p->Jbar, Jb0, sizeof(double) * (size_t)n);
+    mpmc_grid_clear(&sim->grid, 1);
+    TCALL(mpmc_slabs_build(sim));
+    if (!sim->order_ident) fail_msg("run %d: no identity flag", run);
+    if (run) sim->order_ident = 0; /* the same sequence through the order */
+    TCALL(mpmc_p2g(sim, 1e-4));
+    TCALL(mpmc_grid_update(sim, 1e-4));
+    TCALL(mpmc_g2p(sim, 1e-4));
+    const double *src[6] = {sim->grid.node, sim->grid.fbj, p->x, p->v, p->dF, p->J};
+    for (int f = 0; f < 6; ++f) {
+      out[run][f] = malloc(sizeof(double) * len[f]);
+      memcpy(out[run][f], src[f], sizeof(double) * len[f]);
+    }
+  }
+  const char *names[6] = {"grid records", "fbj", "x", "v", "dF", "J"};
+  double sum = 0.0;
+  for (int f = 0; f < 6; ++f) {
+    for (size_t i = 0; i < len[f]; ++i) {
+      if (memcmp(&out[0][f][i], &out[1][f][i], sizeof(double)))
+        fail_msg("%s[%zu]: %.17g in index order, %.17g through the order", names[f], i,
+                 out[0][f][i], out[1][f][i]);
+      sum += fabs(out[0][f][i]);
+    }
+    free(out[0][f]), free(out[1][f]);
+  }
+  if (!(sum > 0.0)) fail_msg("the transfers left everything zero");
+  /* one point to a plane beyond the others' (the sorted order no longer the identity) */
+  p->x[0] = 1.75;
+  TCALL(mpmc_slabs_build(sim));
+  if (sim->order_ident) fail_msg("point 0 moved to x = 1.75: still flagged as identity");
+  if (sim->order[n - 1] != 0) fail_msg("point 0 moved to the last plane: order[%d] = %d", n - 1, sim->order[n - 1]);
+  free(x0), free(v0), free(J0), free(Jb0);
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_2d_fbar), cmocka_unit_test(test_2d_ugimp_total),
                                      cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable), cmocka_unit_test(test_3d_compact),
-                                     cmocka_unit_test(test_slab_order), cmocka_unit_test(test_slab_groups)};
+                                     cmocka_unit_test(test_slab_order), cmocka_unit_test(test_slab_groups),
+                                     cmocka_unit_test(test_index_order)};
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

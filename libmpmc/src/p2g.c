@@ -311,23 +311,28 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
       width = 0;
     }
   }
-  int *order = sim->order;
-#pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1)
+  /* order[k] = k throughout (order_ident) when every run of points in one plane starts at
+   * its own index: positions within a run follow the points' */
+  int *order = sim->order, ident = 1;
+#pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1) reduction(& : ident)
   for (int t = 0; t < nc; ++t) {
     int *fill = cnt + (size_t)t * nmax;
     const int q0 = mpmc_chunk_start(n, t, nc), q1 = mpmc_chunk_start(n, t + 1, nc);
     if (q0 >= q1) continue; /* more threads than points to share */
-    int cur = plane[q0], pos = fill[cur];
+    int cur = plane[q0], pos = fill[cur], same = pos == q0;
     for (int q = q0; q < q1; ++q) {
       const int pl = plane[q];
       if (pl != cur) {
         fill[cur] = pos;
         cur = pl;
         pos = fill[pl];
+        same &= pos == q;
       }
       order[pos++] = q;
     }
+    ident &= same;
   }
+  sim->order_ident = ident;
   sim->nslab = ns;
   sim->slab_axis = ax;
   return slab_groups(sim, nt);

@@ -142,6 +142,7 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
     sim->cap_order = n;
   }
   int *perm = sim->order;
+  sim->order_ident = 0; /* until the next slab build */
   int clo[3], chi[3];
   double *key = tmp, *half = tmp + n, *first = tmp + 2 * (size_t)n; /* w >= 3 columns */
   sim->sort_axis = point_keys(sim, key, half, clo, chi);
