@@ -312,9 +312,10 @@ struct mpmc_sim_s {
   int *order;         /* [n] point indices grouped by slab                             */
   int *slab_start;    /* [nslab + 1] offsets into order                                */
   int nslab, slab_axis, cap_order, cap_slab;
-  int order_ident;    /* order[k] = k for all k: the points are stored slab by slab (the
-                         seeding's and the sort's order, until points cross planes), and
-                         G2P takes the same sequence without the indirection (g2p.c) */
+  int order_ident;    /* order[k] = k for all k (mpmc_slabs_build): the points are stored
+                         slab by slab (as the sort leaves them, and the lattice seeding
+                         where the slab axis is z), and G2P takes the same sequence
+                         without the indirection (g2p.c) */
   /* the slabs of colour c that thread t scatters: c's slabs sl = group[c][t], + 2, ..., below
    * group[c][t + 1], for t < slab_nt (mpmc_slab_group, MPMC_SLABS_OF) */
   int *slab_group;    /* [2][slab_nt + 1] */
