@@ -42,8 +42,9 @@ static double bytes_per_point(const mpmc_sim sim) {
            {p->vol0, 1},       {p->J, 1},       {p->stress, 6},  {p->Jbar, 1},
            {p->be, 6},         {p->eps_p, 1},   {p->lp, 1},      {p->force, d},
            {p->cforce, d},     {p->ustate, p->nustate},          {p->dF, d * d},
-           {p->xn, d}};
+           {p->xn, d},         {p->xoff, d}};
   double b = sizeof(int) * (p->id ? 3.0 : 2.0); /* material id, slab order, point id (sort) */
+  if (p->xnode) b += sizeof(int); /* F-bar's kept first nodes (transfer.h) */
   if (sim->fb_scale) b += sizeof(double); /* F-bar's deferred factors (stress_j2.c) */
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
     if (f[i].a) b += sizeof(double) * (double)f[i].n;

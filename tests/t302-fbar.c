@@ -602,6 +602,48 @@ static void test_gather_at_xn(void **state) {
         }
 }
 
+/* What G2P keeps of x^n for the gather is allocated for the form that needs it and freed
+ * when the form changes (nothing a scene does not use): the weights' offsets and first nodes
+ * for the paper and total forms, the positions for the stable form, neither without F-bar;
+ * each change of form between steps still projects at x^n (test_gather_at_xn's check). */
+static void test_kept_fields(void **state) {
+  (void)state;
+  static const int forms[] = {MPMC_FBAR_PAPER, MPMC_FBAR_STABLE, MPMC_FBAR_TOTAL,
+                              MPMC_FBAR_OFF,   MPMC_FBAR_PAPER};
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  mpmc_sim sim = slump(ctx, 3, MPMC_BASIS_UGIMP, MPMC_FBAR_OFF, 0, 0, SLUMP_HENCKY);
+  const int n = sim->p.n;
+  double *xn = malloc(sizeof(double) * 3 * (size_t)n), dt;
+  assert_non_null(xn);
+  for (size_t f = 0; f < sizeof forms / sizeof forms[0]; ++f) {
+    const int form = forms[f];
+    TCALL(mpmc_sim_set_fbar(sim, form));
+    memcpy(xn, sim->p.x, sizeof(double) * 3 * (size_t)n);
+    TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
+    TCALL(mpmc_sim_step(sim, dt));
+    const int kept = form != MPMC_FBAR_OFF && form != MPMC_FBAR_STABLE;
+    if ((sim->p.xn != NULL) != (form == MPMC_FBAR_STABLE) || (sim->p.xoff != NULL) != kept ||
+        (sim->p.xnode != NULL) != kept)
+      fail_msg("form %d: x^n %s, offsets %s, first nodes %s", form,
+               sim->p.xn ? "kept" : "absent", sim->p.xoff ? "kept" : "absent",
+               sim->p.xnode ? "kept" : "absent");
+    double worst = 0.0;
+    for (int q = 0; q < n && form != MPMC_FBAR_OFF; ++q) {
+      const double e = fabs(projected_at(sim, xn, q) - sim->p.Jbar[q]);
+      worst = e > worst ? e : worst;
+    }
+    if (!(worst <= 1e-13))
+      fail_msg("form %d after form %d: Jbar differs from the projection at x^n by %.3g", form,
+               f ? forms[f - 1] : MPMC_FBAR_OFF, worst);
+  }
+  free(xn);
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+  test_ctx = NULL;
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_homogeneous),
@@ -613,6 +655,7 @@ int main(void) {
       cmocka_unit_test(test_deferred_gather),
       cmocka_unit_test(test_positions_held),
       cmocka_unit_test(test_gather_at_xn),
+      cmocka_unit_test(test_kept_fields),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -39,6 +39,8 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
  * node per lane into base, and w[k], dw[k] (d/dx_p, per metre) of the k-th node of each
  * axis's stencil, k < MPMC_MAX_STENCIL (0 for the fourth); dw may be a constant NULL (the
  * weights alone).  w and dw are 32-byte aligned tables (mpmc_pw4's), stored into directly.
+ * off (may be a constant NULL) gets y below, from which mpmc_ugimp_at gives the same
+ * weights again (F-bar's gather: transfer.h, mpmc_kept_weights4).
  *
  * uGIMP (0 < l <= 1/2): the hat N(x) = max(0, 1 - |x|) averaged over the point,
  * w = (1/2l) int_{x-l}^{x+l} N, with y the point's offset from the middle node of its three
@@ -86,13 +88,10 @@ MPMC_ALWAYS_INLINE void mpmc_floor4(const mpmc_b4d *s, mpmc_b4i *bi, mpmc_b4d *f
 #endif
 }
 
-MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, double inv_h,
-                                        mpmc_b4i *base, mpmc_b4da *w, mpmc_b4da *dw) {
-  const mpmc_b4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0}, s = *sp, l = *lp;
-  mpmc_b4d fl;
-  const mpmc_b4d sh = s - 0.5;
-  mpmc_floor4(&sh, base, &fl);
-  const mpmc_b4d y = (s - fl) - 1.0;
+/* mpmc_ugimp_axes's weights from the point's offset y from its middle node (in cells) */
+MPMC_ALWAYS_INLINE void mpmc_ugimp_at(const mpmc_b4d *yp, const mpmc_b4d *lp, double inv_h,
+                                      mpmc_b4da *w, mpmc_b4da *dw) {
+  const mpmc_b4d zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0}, y = *yp, l = *lp;
   const mpmc_b4d i2l = 0.5 / l, i4l = 0.5 * i2l, gl = i2l * inv_h;
   const mpmc_b4d lo = zero - l, hi = zero + l;
 /* lanes of a where mask m is set, else of b */
@@ -124,6 +123,18 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, 
   }
 }
 
+MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, double inv_h,
+                                        mpmc_b4i *base, mpmc_b4da *w, mpmc_b4da *dw,
+                                        mpmc_b4da *off) {
+  const mpmc_b4d s = *sp;
+  mpmc_b4d fl;
+  const mpmc_b4d sh = s - 0.5;
+  mpmc_floor4(&sh, base, &fl);
+  const mpmc_b4d y = (s - fl) - 1.0;
+  if (off) *off = y;
+  mpmc_ugimp_at(&y, lp, inv_h, w, dw);
+}
+
 /* The weights of the polynomial bases from f, the point's offset (in cells) from its first
  * stencil node, written once for scalars (T double: mpmc_basis_1d) and for vectors (T
  * mpmc_b4d: mpmc_poly_lanes), so both make the same operations and the same bits. */
@@ -144,25 +155,19 @@ MPMC_ALWAYS_INLINE void mpmc_ugimp_axes(const mpmc_b4d *sp, const mpmc_b4d *lp, 
     (w)[3] = x1_ * x1_ * x1_ / 6.0;                                               \
   } while (0)
 
-/* The linear and B-spline weights in the lanes of s = (x_p - origin)/h (four points along
- * one axis), the floor exact as mpmc_basis_1d's, and with dw (may be a constant NULL) their
- * gradients: mpmc_basis_1d's operations per lane, so the same bits. */
-MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, double inv_h,
-                                        mpmc_b4i *base, mpmc_b4da *w, mpmc_b4da *dw) {
-  const mpmc_b4d s = *sp, zero = {0.0, 0.0, 0.0, 0.0};
-  mpmc_b4d fl;
+/* The weights of the linear and B-spline bases, and with dw (may be a constant NULL) their
+ * gradients, in the lanes of f, the points' offsets (in cells) from their first stencil
+ * nodes: mpmc_basis_1d's operations per lane, so the same bits. */
+MPMC_ALWAYS_INLINE void mpmc_poly_at(const int basis, const mpmc_b4d *fp, double inv_h,
+                                     mpmc_b4da *w, mpmc_b4da *dw) {
+  const mpmc_b4d f = *fp, zero = {0.0, 0.0, 0.0, 0.0};
   if (basis == MPMC_BASIS_LINEAR) {
-    mpmc_floor4(&s, base, &fl);
-    const mpmc_b4d f = s - fl;
     MPMC_LINEAR_W(mpmc_b4d, f, w);
     if (dw) {
       dw[0] = zero - inv_h;
       dw[1] = zero + inv_h;
     }
   } else if (basis == MPMC_BASIS_BSPLINE2) {
-    const mpmc_b4d sh = s - 0.5;
-    mpmc_floor4(&sh, base, &fl);
-    const mpmc_b4d f = s - fl;
     MPMC_BSPLINE2_W(mpmc_b4d, f, w);
     if (dw) {
       const mpmc_b4d x1 = f - 1.0;
@@ -171,9 +176,6 @@ MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, dou
       dw[2] = (f - 0.5) * inv_h;
     }
   } else { /* cubic */
-    mpmc_floor4(&s, base, &fl);
-    *base -= 1;
-    const mpmc_b4d f = s - (fl - 1.0);
     MPMC_BSPLINE3_W(mpmc_b4d, f, w);
     if (dw) {
       const mpmc_b4d x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
@@ -185,15 +187,43 @@ MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, dou
   }
 }
 
+/* The linear and B-spline weights in the lanes of s = (x_p - origin)/h (four points along
+ * one axis), the floor exact as mpmc_basis_1d's, and with dw (may be a constant NULL) their
+ * gradients: mpmc_basis_1d's operations per lane, so the same bits.  off (may be a constant
+ * NULL) gets the offsets f that mpmc_poly_at takes. */
+MPMC_ALWAYS_INLINE void mpmc_poly_lanes(const int basis, const mpmc_b4d *sp, double inv_h,
+                                        mpmc_b4i *base, mpmc_b4da *w, mpmc_b4da *dw,
+                                        mpmc_b4da *off) {
+  const mpmc_b4d s = *sp;
+  mpmc_b4d fl, f;
+  if (basis == MPMC_BASIS_LINEAR) {
+    mpmc_floor4(&s, base, &fl);
+    f = s - fl;
+  } else if (basis == MPMC_BASIS_BSPLINE2) {
+    const mpmc_b4d sh = s - 0.5;
+    mpmc_floor4(&sh, base, &fl);
+    f = s - fl;
+  } else { /* cubic */
+    mpmc_floor4(&s, base, &fl);
+    *base -= 1;
+    f = s - (fl - 1.0);
+  }
+  if (off) *off = f;
+  mpmc_poly_at(basis, &f, inv_h, w, dw);
+}
+
 /* Weights w[k] and gradients dw[k] (d/dx_p, per metre) of nodes base..base+S-1 along one
- * axis.  s = (x_p - origin)/h; l = uGIMP half-length / h. */
-MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_h, int *base,
-                                      double *w, double *dw) {
+ * axis.  s = (x_p - origin)/h; l = uGIMP half-length / h.  off (may be a constant NULL)
+ * gets the offset that mpmc_basis_1d_at takes: a lane of mpmc_poly_lanes's or
+ * mpmc_ugimp_axes's. */
+MPMC_ALWAYS_INLINE void mpmc_basis_1d_off(int basis, double s, double l, double inv_h,
+                                          int *base, double *w, double *dw, double *off) {
   switch (basis) {
     case MPMC_BASIS_LINEAR: {
       const int b = mpmc_ifloor(s);
       const double f = s - b;
       *base = b;
+      if (off) *off = f;
       MPMC_LINEAR_W(double, f, w);
       dw[0] = -inv_h;
       dw[1] = inv_h;
@@ -204,6 +234,7 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       const double f = s - b; /* in [0.5, 1.5) */
       const double x1 = f - 1.0;
       *base = b;
+      if (off) *off = f;
       MPMC_BSPLINE2_W(double, f, w);
       dw[0] = -(1.5 - f) * inv_h;
       dw[1] = -2.0 * x1 * inv_h;
@@ -215,6 +246,7 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
       const double f = s - b; /* in [1, 2) */
       const double x0 = 2.0 - f, x1 = f - 1.0, x2 = 2.0 - f, x3 = f - 1.0;
       *base = b;
+      if (off) *off = f;
       MPMC_BSPLINE3_W(double, f, w);
       dw[0] = -0.5 * x0 * x0 * inv_h;
       dw[1] = (1.5 * x1 * x1 - 2.0 * x1) * inv_h;
@@ -224,17 +256,40 @@ MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_
     }
     default: { /* MPMC_BASIS_UGIMP: one lane of mpmc_ugimp_axes, and the fourth node (0), as
                   its callers' arrays are that long */
-      mpmc_b4da wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL];
+      mpmc_b4da wv[MPMC_MAX_STENCIL], dv[MPMC_MAX_STENCIL], yv;
       mpmc_b4i b;
       const mpmc_b4d sv = {s, s, s, s}, lv = {l, l, l, l};
-      mpmc_ugimp_axes(&sv, &lv, inv_h, &b, wv, dv);
+      mpmc_ugimp_axes(&sv, &lv, inv_h, &b, wv, dv, &yv);
       *base = b[0];
+      if (off) *off = yv[0];
       for (int k = 0; k < MPMC_MAX_STENCIL; ++k) {
         w[k] = wv[k][0];
         dw[k] = dv[k][0];
       }
       break;
     }
+  }
+}
+
+MPMC_ALWAYS_INLINE void mpmc_basis_1d(int basis, double s, double l, double inv_h, int *base,
+                                      double *w, double *dw) {
+  mpmc_basis_1d_off(basis, s, l, inv_h, base, w, dw, NULL);
+}
+
+/* The weights w[k] alone from the offset off that mpmc_basis_1d_off gave (l as there): the
+ * same operations, so the same bits; and those of mpmc_poly_at and mpmc_ugimp_at per lane. */
+MPMC_ALWAYS_INLINE void mpmc_basis_1d_at(int basis, double off, double l, double *w) {
+  if (basis == MPMC_BASIS_LINEAR) {
+    MPMC_LINEAR_W(double, off, w);
+  } else if (basis == MPMC_BASIS_BSPLINE2) {
+    MPMC_BSPLINE2_W(double, off, w);
+  } else if (basis == MPMC_BASIS_BSPLINE3) {
+    MPMC_BSPLINE3_W(double, off, w);
+  } else {
+    mpmc_b4da wv[MPMC_MAX_STENCIL];
+    const mpmc_b4d yv = {off, off, off, off}, lv = {l, l, l, l};
+    mpmc_ugimp_at(&yv, &lv, 1.0, wv, NULL);
+    for (int k = 0; k < MPMC_MAX_STENCIL; ++k) w[k] = wv[k][0];
   }
 }
 

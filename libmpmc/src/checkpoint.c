@@ -6,8 +6,8 @@
  *
  * The file is a list of blocks; each block is a writer and a reader below and one line in
  * `blocks`.  Not saved: user-material functions (the caller re-attaches them with
- * mpmc_sim_set_material_user_fn) and scratch arrays (dF, xn, grid arrays) that every step
- * recomputes.  Rigid bodies (contact.h) are saved with their motion, last reaction and
+ * mpmc_sim_set_material_user_fn) and scratch arrays (dF, xn, xoff, xnode, grid arrays) that
+ * every step recomputes.  Rigid bodies (contact.h) are saved with their motion, last reaction and
  * friction anchors. */
 #include <errno.h>
 #include <math.h>

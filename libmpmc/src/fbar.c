@@ -16,7 +16,9 @@
  * the points at x^n and, but in the stable form, the weights at hand: in the paper and total
  * forms P2G adds V_i to the node records (slot MPMC_VSLOT, beside the mass) and G2P (V J)_i to
  * fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P sets
- * grid.fb_done and leaves x^n in xn (the points have moved by then): the gather reads it.
+ * grid.fb_done and keeps what the gather needs of x^n (the points have moved by then): in the
+ * paper and total forms the weights, as the basis's offsets and first nodes (xoff, xnode;
+ * transfer.h, mpmc_kept_weights4), in the stable form the positions (xn).
  * Called on its own (tests) the projection scatters here and gathers, both at x,
  * recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter leaves
  * Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
@@ -50,7 +52,7 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   const int S = mpmc_stencil(BASIS);
   double *restrict rec = g->node, *restrict fj = g->fbj;
   mpmc_pw4 t; /* lane 0 */
-  mpmc_point_weights1(DIM, BASIS, 0, g, p->x, p->lp, q, &t);
+  mpmc_point_weights1(DIM, BASIS, 0, 0, g, p->x, p->lp, q, &t);
   const mpmc_v2d vv = scatter_values(sim, DIM, q);
   /* in the products' order of P2G (V: w_x (w_y (w_z V))) and G2P (V j: ((w_x V j) w_z) w_y) */
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
@@ -149,15 +151,18 @@ MPMC_ALWAYS_INLINE double gather_dot(const int BASIS, const double *wx, const in
   return pi;
 }
 
-/* Gather point q, at x^n = xs[q]: Pi = sum w Jbar_i (Algorithm 1, step 4); returns the
- * factor of dF. */
+/* Gather point q, at x^n = xs[q] (xs NULL: with the weights G2P kept, transfer.h's
+ * mpmc_kept_weights1): Pi = sum w Jbar_i (Algorithm 1, step 4); returns the factor of dF. */
 MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BASIS,
                                        const double *xs, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
   const double inv = 1.0 / p->Jbar[q];
   mpmc_pw4 t; /* lane 0 */
-  mpmc_point_weights1(DIM, BASIS, 0, g, xs, p->lp, q, &t);
+  if (xs)
+    mpmc_point_weights1(DIM, BASIS, 0, 0, g, xs, p->lp, q, &t);
+  else
+    mpmc_kept_weights1(DIM, BASIS, g, p, q, &t);
   mpmc_b4d acc;
   gather_rows(g, DIM, BASIS, (size_t)t.node0[0], &t.w[1][0][0], &t.w[2][0][0], 4, &acc);
   return projection_scale(p, DIM, q, gather_dot(BASIS, &t.w[0][0][0], 4, &acc), inv);
@@ -288,15 +293,25 @@ MPMC_ALWAYS_INLINE void scale_dF(mpmc_particles *p, const int DIM, int q, double
   for (int k = 0; k < DIM * DIM; ++k) dF[k] *= scale;
 }
 
-/* one point's factor in either form (ST: the stable one) */
+/* the weights of the consecutive points idx[0 .. 3] at xs, or those G2P kept (xs NULL) */
+MPMC_ALWAYS_INLINE void gather_weights4(mpmc_sim sim, const int D, const int B, const double *xs,
+                                        const int *idx, mpmc_pw4 *t) {
+  if (xs)
+    mpmc_point_weights4(D, B, 0, 0, &sim->grid, xs, sim->p.lp, idx, t);
+  else
+    mpmc_kept_weights4(D, B, &sim->grid, &sim->p, idx[0], t);
+}
+
+/* one point's factor in either form (ST: the stable one, which takes x^n from xs) */
 MPMC_ALWAYS_INLINE double gather_scale1(mpmc_sim sim, const int D, const int B, const int ST,
                                         const double *xs, int q) {
   return ST ? gather_stable_scale(sim, D, B, xs, q) : gather_scale(sim, D, B, xs, q);
 }
 
-/* The gather's factors of points q0 .. q1 - 1 at positions xs (Algorithm 1, step 4) into
- * scale[q - q0]: of material id's points (id < 0: of every point; the others' entries and
- * Jbar left alone).  The paper and total forms eight points at a time where they are all
+/* The gather's factors of points q0 .. q1 - 1 at positions xs, or with xs a constant NULL
+ * with the weights G2P kept (not in the stable form), into scale[q - q0] (Algorithm 1, step
+ * 4): of material id's points (id < 0: of every point; the others' entries and Jbar left
+ * alone).  The paper and total forms eight points at a time where they are all
  * gathered, else four, then one by one, each lane with the operations of gather_scale; the
  * stable form (ST) four at a time, else one by one (gather_stable_scale): the same bits as
  * point by point. */
@@ -308,8 +323,8 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
   for (; !ST && one && q + 8 <= q1; q += 8) {
     const int idx[8] = {q, q + 1, q + 2, q + 3, q + 4, q + 5, q + 6, q + 7};
     mpmc_pw4 t[2]; /* the same bits as mpmc_point_weights1 per point */
-    mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t[0]);
-    mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx + 4, &t[1]);
+    gather_weights4(sim, D, B, xs, idx, &t[0]);
+    gather_weights4(sim, D, B, xs, idx + 4, &t[1]);
     gather_scale8(sim, D, B, t, q, scale + (q - q0));
   }
   for (; q + 4 <= q1; q += 4) {
@@ -321,7 +336,7 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
       } else {
         const int idx[4] = {q, q + 1, q + 2, q + 3};
         mpmc_pw4 t; /* the same bits as mpmc_point_weights1 per point */
-        mpmc_point_weights4(D, B, 0, &sim->grid, xs, sim->p.lp, idx, &t);
+        gather_weights4(sim, D, B, xs, idx, &t);
         gather_scale4(sim, D, B, &t, q, scale + (q - q0));
       }
     } else { /* materials mixed: the others' scale and Jbar left alone */
@@ -337,17 +352,18 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
  * updates' chunks: batch4.h, fbar_gather_chunk) */
 #define GATHER_CHUNK 256
 
-/* The F-bar phase's gather (ST: the stable form's): every point's, at positions xs (x^n),
- * GATHER_CHUNK at a time, its dF scaled in place; in the kernels' macro, so that ST reaches
- * the OpenMP region as a constant (transfer.h, MPMC_KERNELS) */
-#define GATHER_CHUNKS(D, B, ST)                                                              \
+/* The F-bar phase's gather (ST: the stable form's): every point's, at positions XS (x^n; a
+ * constant NULL: with the weights G2P kept), GATHER_CHUNK at a time, its dF scaled in place;
+ * in the kernels' macro, so that ST and XS reach the OpenMP region as constants (transfer.h,
+ * MPMC_KERNELS) */
+#define GATHER_CHUNKS(D, B, ST, XS)                                                          \
   do {                                                                                       \
     const int n = sim->p.n, nch = (n + GATHER_CHUNK - 1) / GATHER_CHUNK;                     \
     _Pragma("omp parallel for schedule(static) if (n > MPMC_OMP_MIN)")                       \
     for (int ch = 0; ch < nch; ++ch) {                                                       \
       const int q0 = ch * GATHER_CHUNK, q1 = q0 + GATHER_CHUNK < n ? q0 + GATHER_CHUNK : n;  \
       double scale[GATHER_CHUNK];                                                            \
-      gather_points(sim, D, B, ST, xs, -1, q0, q1, scale);                                   \
+      gather_points(sim, D, B, ST, XS, -1, q0, q1, scale);                                   \
       for (int q = q0; q < q1; ++q) scale_dF(&sim->p, D, q, scale[q - q0]);                  \
     }                                                                                        \
   } while (0)
@@ -362,16 +378,23 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
         for (int k = start[sl]; k < start[sl + 1]; ++k) scatter_point(sim, D, B, order[k]);  \
     }                                                                                        \
   }                                                                                          \
-  static void gather_##D##_##B(mpmc_sim sim, const double *xs) { GATHER_CHUNKS(D, B, 0); }   \
-  static void gather_stable_##D##_##B(mpmc_sim sim, const double *xs) {                      \
-    GATHER_CHUNKS(D, B, 1);                                                                  \
+  /* xs NULL: with the weights G2P kept */                                                   \
+  static void gather_##D##_##B(mpmc_sim sim, const double *xs) {                             \
+    if (xs)                                                                                  \
+      GATHER_CHUNKS(D, B, 0, xs);                                                            \
+    else                                                                                     \
+      GATHER_CHUNKS(D, B, 0, (const double *)NULL);                                          \
   }                                                                                          \
-  /* the deferred gather of points q0 .. q1 - 1 of material id (x^n in xn by then) */        \
+  static void gather_stable_##D##_##B(mpmc_sim sim, const double *xs) {                      \
+    GATHER_CHUNKS(D, B, 1, xs);                                                              \
+  }                                                                                          \
+  /* the deferred gather of points q0 .. q1 - 1 of material id (after G2P: x^n in xn, or the \
+   * weights at x^n kept) */                                                                 \
   static void gather_range_##D##_##B(mpmc_sim sim, int id, int q0, int q1, double *scale) {  \
     if (sim->fbar == MPMC_FBAR_STABLE)                                                       \
       gather_points(sim, D, B, 1, sim->p.xn, id, q0, q1, scale);                             \
     else                                                                                     \
-      gather_points(sim, D, B, 0, sim->p.xn, id, q0, q1, scale);                             \
+      gather_points(sim, D, B, 0, (const double *)NULL, id, q0, q1, scale);                  \
   }                                                                                          \
   /* the stable form's supports reach no further than the cubic B-spline's (nodes c - 1 ..  \
    * c + 2 of a point in cell c): the slabs keep same-coloured ones apart all the same */    \
@@ -400,7 +423,8 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   mpmc_grid *g = &sim->grid;
   const int stable = sim->fbar == MPMC_FBAR_STABLE;
   for (int m = 0; m < sim->nmat && defer; ++m) defer = sim->mats[m].ops->gathers_fbar;
-  const double *xs = g->fb_done ? sim->p.xn : sim->p.x; /* x^n: G2P has moved the points */
+  /* x^n: after G2P, which has moved the points, as it kept it (xn, or the weights: NULL) */
+  const double *xs = !g->fb_done ? sim->p.x : stable ? sim->p.xn : NULL;
   if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
     mpmc_grid_clear_fb_active(g);
     if (stable)
@@ -439,7 +463,7 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   }
   g->fb_gather = defer;
   if (defer)
-    ; /* the material update gathers, from xn (mpmc_fbar_gather_range), into sim->fb_scale */
+    ; /* the material update gathers (mpmc_fbar_gather_range) into sim->fb_scale */
   else if (stable)
     MPMC_KERNEL_CALL(gather_stable_, sim, sim, xs);
   else

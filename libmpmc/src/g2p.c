@@ -1,9 +1,11 @@
 /* Grid to particle: velocity with the FLIP/PIC blend (eqs 11-13), relative deformation
  * gradient dF = 1 + dt sum v_i (x) grad w (eq 16), J <- J det(dF) so that V = J V0 (eq 15),
- * position (eq 17), in place.  With F-bar the old positions go to xn as well: the
- * projection's gather, in the material update, still needs the weights at x^n; its scatter
- * (fbar.c) is fused in here, where those weights are at hand (in the paper and total forms
- * only of V^n j: P2G scattered V^n, p2g.c). */
+ * position (eq 17), in place.  With F-bar the projection's gather, in the material update,
+ * still needs the weights at x^n: in the paper and total forms G2P keeps them, as the
+ * offsets from which the basis gives them and the first nodes (xoff, xnode: transfer.h,
+ * mpmc_keep_weights), in the stable form, whose space has weights of its own, the old
+ * positions (xn).  The projection's scatter (fbar.c) is fused in here, where those weights
+ * are at hand (in the paper and total forms only of V^n j: P2G scattered V^n, p2g.c). */
 #include <limits.h>
 #include <math.h>
 
@@ -14,7 +16,7 @@
 
 typedef struct {
   double eta;             /* FLIP/PIC blend                                             */
-  double *xold;           /* with F-bar xn, which gets x^n for the gather; else NULL    */
+  double *xold;           /* with F-bar's stable form xn, which gets x^n for the gather  */
   double xmin[3], xmax[3];/* points may drift up to one cell beyond the box (walls act on
                              the nodes there); further out the support leaves the grid   */
 } g2p_ctx;
@@ -194,13 +196,14 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     v[a] = va;
     v2 += va * va;
     const double x0 = p->x[qd + a], xa = x0 + dt * vpic[a];
-    if (FB) c->xold[qd + a] = x0;
+    if (FB == 2) c->xold[qd + a] = x0;
     p->x[qd + a] = xa;
     ok &= (xa >= c->xmin[a]) & (xa <= c->xmax[a]);
   }
   *v2max = v2 > *v2max ? v2 : *v2max; /* NaN skipped, as there */
   return ok;
 }
+
 
 /* Without F-bar the points run in index order, split evenly among the threads; with it by
  * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
@@ -217,8 +220,9 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int t = 0; t < nc; ++t) {                                                            \
       double *f_ = t ? fbp + per * (size_t)(t - 1) : fb0;                                     \
       const int k1_ = mpmc_chunk_start(sim->p.n, t + 1, nc);                                  \
-      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,         \
-                    order, mpmc_chunk_start(sim->p.n, t, nc), k1_, q, l, w4,                  \
+      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, (FBV) != 2, &keep, &sim->grid,           \
+                    sim->p.x, sim->p.lp, order, mpmc_chunk_start(sim->p.n, t, nc), k1_, q, l, \
+                    w4,                                                                       \
                     if (!g2p_point(sim, D, B, FBV, dt, c, f_, q, &w4, l, &v2m) &&             \
                         q < first_bad) first_bad = q);                                        \
     }                                                                                         \
@@ -228,8 +232,8 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     for (int colour = 0; colour < 2; ++colour) {                                              \
       _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
       MPMC_SLABS_OF(sim, colour, sl)                                                          \
-        MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,       \
-                      ORD, start[sl], start[sl + 1], q, l, w4,                                \
+        MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, (FBV) != 2, &keep, &sim->grid,         \
+                      sim->p.x, sim->p.lp, ORD, start[sl], start[sl + 1], q, l, w4,           \
                       if (!g2p_point(sim, D, B, FBV, dt, c, fb0, q, &w4, l, &v2m) &&          \
                           q < first_bad) first_bad = q);                                      \
     }                                                                                         \
@@ -249,8 +253,8 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     const int nc = sim->p.n > MPMC_OMP_MIN ? mpmc_max_threads() : 1; /* chunks */            \
     _Pragma("omp parallel for schedule(static, 1) reduction(min : first_bad) reduction(max : v2m) num_threads(nc)") \
     for (int t = 0; t < nc; ++t)                                                              \
-      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, &sim->grid, sim->p.x, sim->p.lp,         \
-                    (const int *)NULL, mpmc_chunk_start(sim->p.n, t, nc),                     \
+      MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, 0, NULL, &sim->grid, sim->p.x,           \
+                    sim->p.lp, (const int *)NULL, mpmc_chunk_start(sim->p.n, t, nc),          \
                     mpmc_chunk_start(sim->p.n, t + 1, nc), q, l, w4,                          \
                     if (!g2p_point(sim, D, B, 0, dt, c, NULL, q, &w4, l, &v2m) &&             \
                         q < first_bad) first_bad = q);                                        \
@@ -261,6 +265,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
                               int *bad, double *vm) {                                         \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;                \
     const int stable = sim->fbar == MPMC_FBAR_STABLE;                                         \
+    const mpmc_keep keep = mpmc_keep_of(&sim->p);                                             \
     double *fb0 = stable ? sim->grid.fb : sim->grid.fbj;                                      \
     int first_bad = INT_MAX;                                                                  \
     double v2m = 0.0;                                                                         \
@@ -303,7 +308,7 @@ static int report(mpmc_sim sim, int q) {
 /** Phase 3 of the step. */
 int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   const mpmc_grid *g = &sim->grid;
-  g2p_ctx c = {.eta = sim->flip, .xold = sim->fbar ? sim->p.xn : NULL};
+  g2p_ctx c = {.eta = sim->flip, .xold = sim->fbar == MPMC_FBAR_STABLE ? sim->p.xn : NULL};
   for (int a = 0; a < sim->dim; ++a) {
     c.xmin[a] = g->lo[a] - g->h;
     c.xmax[a] = g->hi[a] + g->h;

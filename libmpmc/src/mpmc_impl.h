@@ -75,7 +75,12 @@ typedef struct {
                     mpmc_sim_get_particle_ids; NULL: ids are the indices) (sort.c)      */
   /* step scratch */
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
-  double *xn;    /* [n][dim] with F-bar x^n, from G2P (which moves x) to the gather */
+  double *xn;    /* [n][dim] with F-bar's stable form x^n, from G2P (which moves x) to the
+                    gather                                                          */
+  double *xoff;  /* [dim][cap] with F-bar's paper and total forms, from G2P to the gather:
+                    the points' offsets at x^n from their first stencil nodes (axis a's
+                    at xoff + a cap), from which the basis gives their weights          */
+  int *xnode;    /* [n] those first stencil nodes (transfer.h, mpmc_kept_weights4)   */
 } mpmc_particles;
 
 /* A point's name in error messages: its index, and its id (the index it was added with)
@@ -142,7 +147,8 @@ typedef struct {
   int rows_skip; /* slab builds left that take the whole box's rows (p2g.c, row_ranges) */
   int fb_done;         /* G2P scattered this step's F-bar volumes (fused, race-free)     */
   int fb_gather;       /* the step's F-bar gather is left to the material update (every
-                          material's ops->gathers_fbar): it reads x^n from the points' xn */
+                          material's ops->gathers_fbar): it takes x^n as G2P kept it
+                          (the points' xoff and xnode, or xn; fbar.c)                   */
   int *ccount;         /* p2g.c scratch: points per plane of cells, slab fill positions   */
   size_t cap_ccount;
   /* per-thread accumulation (p2g.c, private_grids) when slabs cannot keep the threads busy:

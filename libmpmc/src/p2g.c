@@ -475,7 +475,7 @@ static double *private_grids(mpmc_sim sim, int nt) {
       for (int t = 0; t < nc; ++t) {                                                        \
         const int k1 = mpmc_chunk_start(sim->p.n, t + 1, nc);                               \
         double *rec = t ? priv + per * (size_t)(t - 1) : node;                              \
-        MPMC_BATCHES4(0, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order,                     \
+        MPMC_BATCHES4(0, D, B, 1, 0, NULL, &sim->grid, sim->p.x, sim->p.lp, order,          \
                       mpmc_chunk_start(sim->p.n, t, nc), k1, q, l, w4,                      \
                       p2g_point(sim, D, B, rec, q, &w4, l));                                \
       }                                                                                     \
@@ -484,8 +484,9 @@ static double *private_grids(mpmc_sim sim, int nt) {
     for (int colour = 0; colour < 2; ++colour) {                                            \
       _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
       MPMC_SLABS_OF(sim, colour, sl)                                                        \
-        MPMC_BATCHES4(0, D, B, 1, &sim->grid, sim->p.x, sim->p.lp, order, start[sl],           \
-                      start[sl + 1], q, l, w4, p2g_point(sim, D, B, node, q, &w4, l));      \
+        MPMC_BATCHES4(0, D, B, 1, 0, NULL, &sim->grid, sim->p.x, sim->p.lp, order,          \
+                      start[sl], start[sl + 1], q, l, w4,                                   \
+                      p2g_point(sim, D, B, node, q, &w4, l));                               \
     }                                                                                       \
   }
 MPMC_KERNELS(P2G_KERNEL)

@@ -392,7 +392,25 @@ int mpmc_sim_prepare(mpmc_sim sim) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
     for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
   }
-  if (sim->fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->xn, d, 0.0));
+  /* x^n for the gather (fbar.c): as positions for the stable form, as the weights' offsets
+   * and first nodes for the others (transfer.h, mpmc_kept_weights4); the other's freed */
+  double **xkeep = sim->fbar == MPMC_FBAR_STABLE ? &p->xn : &p->xoff;
+  if (sim->fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, xkeep, d, 0.0));
+  if (sim->fbar && sim->fbar != MPMC_FBAR_STABLE && !p->xnode) {
+    p->xnode = calloc((size_t)p->cap, sizeof(int));
+    MPMC_CHECK(p->xnode, ctx, MPMC_ERR_MEMORY, "cannot allocate a particle field for %d points",
+               p->cap);
+  }
+  if (sim->fbar != MPMC_FBAR_STABLE) {
+    free(p->xn);
+    p->xn = NULL;
+  }
+  if (sim->fbar == MPMC_FBAR_OFF || sim->fbar == MPMC_FBAR_STABLE) {
+    free(p->xoff);
+    free(p->xnode);
+    p->xoff = NULL;
+    p->xnode = NULL;
+  }
   if (sim->basis == MPMC_BASIS_UGIMP && !p->lp) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->lp, 1, 0.0));
     for (int q = 0; q < p->n; ++q) {

@@ -12,19 +12,22 @@
 
 /* The 1D weights and gradients of four points, lanes the points: w[a][k][l] of point l's
  * k-th stencil node along axis a (so a point's weights lie MPMC_PW4_AXIS doubles apart
- * between axes and 4 apart between nodes), node0 each point's first stencil node. */
+ * between axes and 4 apart between nodes), node0 each point's first stencil node; off[a][l]
+ * (where asked for) point l's offset along axis a from which the basis gives its weights
+ * (basis.h, mpmc_poly_at and mpmc_ugimp_at). */
 typedef struct {
   double w[3][MPMC_MAX_STENCIL][4] __attribute__((aligned(32)));
   double dw[3][MPMC_MAX_STENCIL][4] __attribute__((aligned(32)));
+  double off[3][4] __attribute__((aligned(32)));
   long long node0[4];
 } mpmc_pw4;
 #define MPMC_PW4_AXIS (MPMC_MAX_STENCIL * 4)
 
-/* The weights of points idx[0..3] at x (GRAD = 0: w alone): per axis one evaluation for the
- * four, the same operations per lane as mpmc_point_weights1 for one point (the same bits).
- * A batch of fewer points repeats one of them. */
+/* The weights of points idx[0..3] at x (GRAD = 0: w alone; OFF = 1: and their offsets):
+ * per axis one evaluation for the four, the same operations per lane as mpmc_point_weights1
+ * for one point (the same bits).  A batch of fewer points repeats one of them. */
 MPMC_ALWAYS_INLINE void mpmc_point_weights4(const int DIM, const int BASIS, const int GRAD,
-                                            const mpmc_grid *g, const double *x,
+                                            const int OFF, const mpmc_grid *g, const double *x,
                                             const double *lp, const int *idx, mpmc_pw4 *t) {
   mpmc_b4i b[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
   const size_t i0 = (size_t)idx[0] * DIM, i1 = (size_t)idx[1] * DIM, i2 = (size_t)idx[2] * DIM,
@@ -35,10 +38,10 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights4(const int DIM, const int BASIS, cons
     if (BASIS == MPMC_BASIS_UGIMP) {
       const mpmc_b4d lv = (mpmc_b4d){lp[idx[0]], lp[idx[1]], lp[idx[2]], lp[idx[3]]} * g->inv_h;
       mpmc_ugimp_axes(&s, &lv, g->inv_h, &b[a], (mpmc_b4da *)t->w[a],
-                      GRAD ? (mpmc_b4da *)t->dw[a] : NULL);
+                      GRAD ? (mpmc_b4da *)t->dw[a] : NULL, OFF ? (mpmc_b4da *)t->off[a] : NULL);
     } else {
       mpmc_poly_lanes(BASIS, &s, g->inv_h, &b[a], (mpmc_b4da *)t->w[a],
-                      GRAD ? (mpmc_b4da *)t->dw[a] : NULL);
+                      GRAD ? (mpmc_b4da *)t->dw[a] : NULL, OFF ? (mpmc_b4da *)t->off[a] : NULL);
     }
   }
   /* the linear indices, in 32 bits (the grid has at most 2^31 nodes: mpmc_grid_setup) */
@@ -48,18 +51,19 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights4(const int DIM, const int BASIS, cons
   memcpy(t->node0, &ni, sizeof ni);
 }
 
-/* Lane 0 of t: the weights of point q alone (GRAD = 0: w alone), axis by axis in scalars
- * (mpmc_basis_1d: the same bits as a lane of mpmc_point_weights4).  For G2P's linear basis
- * (MPMC_BATCHES4) and F-bar's single points (fbar.c). */
+/* Lane 0 of t: the weights of point q alone (GRAD = 0: w alone; OFF = 1: and its offsets),
+ * axis by axis in scalars (mpmc_basis_1d: the same bits as a lane of mpmc_point_weights4).
+ * For G2P's linear basis (MPMC_BATCHES4) and F-bar's single points (fbar.c). */
 MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, const int GRAD,
-                                            const mpmc_grid *g, const double *x,
+                                            const int OFF, const mpmc_grid *g, const double *x,
                                             const double *lp, int q, mpmc_pw4 *t) {
   size_t node0 = 0, stride = 1;
   for (int a = 0; a < DIM; ++a) {
     int b;
     double w[MPMC_MAX_STENCIL], dw[MPMC_MAX_STENCIL];
-    mpmc_basis_1d(BASIS, (x[(size_t)q * DIM + a] - g->origin[a]) * g->inv_h,
-                  BASIS == MPMC_BASIS_UGIMP ? lp[q] * g->inv_h : 0.0, g->inv_h, &b, w, dw);
+    mpmc_basis_1d_off(BASIS, (x[(size_t)q * DIM + a] - g->origin[a]) * g->inv_h,
+                      BASIS == MPMC_BASIS_UGIMP ? lp[q] * g->inv_h : 0.0, g->inv_h, &b, w, dw,
+                      OFF ? &t->off[a][0] : NULL);
     for (int k = 0; k < mpmc_stencil(BASIS); ++k) {
       t->w[a][k][0] = w[k];
       if (GRAD) t->dw[a][k][0] = dw[k];
@@ -74,13 +78,16 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, cons
  * k), k0 <= k < k1: in batches of four (mpmc_point_weights4; the last batch repeats its last
  * point as needed, the repeats' weights computed, not used), or, if ONE, one by one
  * (mpmc_point_weights1, l = 0).  G2P takes the linear basis's one by one: batched, its
- * point body took 10 instructions more, the weights saving 1 (P2G's, batched, save 5). */
-#define MPMC_BATCHES4(ONE, DIM, BASIS, GRAD, g, x, lp, order, k0, k1, q, l, t, body)         \
+ * point body took 10 instructions more, the weights saving 1 (P2G's, batched, save 5).
+ * KEEP = 1 (G2P with F-bar's paper and total forms): the points' weights are kept where kp
+ * says for the gather (mpmc_keep_weights) before the body runs. */
+#define MPMC_BATCHES4(ONE, DIM, BASIS, GRAD, KEEP, kp, g, x, lp, order, k0, k1, q, l, t, body) \
   if (ONE) {                                                                                \
     for (int kb_ = (k0); kb_ < (k1); ++kb_) {                                               \
       const int q = (order) ? (order)[kb_] : kb_, l = 0;                                    \
       mpmc_pw4 t;                                                                           \
-      mpmc_point_weights1(DIM, BASIS, GRAD, g, x, lp, q, &t);                               \
+      mpmc_point_weights1(DIM, BASIS, GRAD, KEEP, g, x, lp, q, &t);                         \
+      if (KEEP) mpmc_keep_weights(DIM, kp, &t, &q, 1, 0);                                   \
       body;                                                                                 \
     }                                                                                       \
   } else                                                                                    \
@@ -92,7 +99,8 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, cons
         idx_[l_] = (order) ? (order)[k_] : k_;                                              \
       }                                                                                     \
       mpmc_pw4 t;                                                                           \
-      mpmc_point_weights4(DIM, BASIS, GRAD, g, x, lp, idx_, &t);                            \
+      mpmc_point_weights4(DIM, BASIS, GRAD, KEEP, g, x, lp, idx_, &t);                      \
+      if (KEEP) mpmc_keep_weights(DIM, kp, &t, idx_, nb_, !(order));                        \
       for (int l = 0; l < nb_; ++l) {                                                       \
         const int q = idx_[l];                                                              \
         body;                                                                               \
@@ -117,6 +125,8 @@ typedef double mpmc_vdu
 typedef double mpmc_v2du __attribute__((vector_size(2 * sizeof(double)), aligned(8), may_alias));
 /* four doubles at any double's address, aliasing (rows of a stencil's scalar node values) */
 typedef double mpmc_b4du __attribute__((vector_size(4 * sizeof(double)), aligned(8), may_alias));
+/* four ints at any int's address, aliasing */
+typedef int mpmc_b4iu __attribute__((vector_size(4 * sizeof(int)), aligned(4), may_alias));
 #define MPMC_V(p) (*(mpmc_vdu *)(p))
 #define MPMC_VC(p) (*(const mpmc_vdu *)(p))
 #define MPMC_V2(p) (*(mpmc_v2du *)(p))
@@ -129,6 +139,66 @@ typedef double mpmc_b4du __attribute__((vector_size(4 * sizeof(double)), aligned
 /* vectors per record, and those of its mass-momentum half */
 #define MPMC_NV (MPMC_NREC / MPMC_VW)
 #define MPMC_NC (MPMC_FOFF / MPMC_VW)
+
+/* F-bar's gather (fbar.c) takes the weights of the points at x^n from what G2P kept of them
+ * (g2p.c, MPMC_BATCHES4's KEEP): their offsets (axis a's at p->xoff + a p->cap) and first nodes
+ * (p->xnode).  mpmc_kept_weights4: points q .. q + 3, lanes; mpmc_kept_weights1: point q, lane
+ * 0.  The same bits as each other, and the weights the basis gives at those offsets. */
+MPMC_ALWAYS_INLINE void mpmc_kept_weights4(const int DIM, const int BASIS, const mpmc_grid *g,
+                                           const mpmc_particles *p, int q, mpmc_pw4 *t) {
+  for (int a = 0; a < DIM; ++a) {
+    const mpmc_b4d off = *(const mpmc_b4du *)(p->xoff + (size_t)a * (size_t)p->cap + (size_t)q);
+    if (BASIS == MPMC_BASIS_UGIMP) {
+      const mpmc_b4d lv = *(const mpmc_b4du *)(p->lp + q) * g->inv_h;
+      mpmc_ugimp_at(&off, &lv, g->inv_h, (mpmc_b4da *)t->w[a], NULL);
+    } else {
+      mpmc_poly_at(BASIS, &off, g->inv_h, (mpmc_b4da *)t->w[a], NULL);
+    }
+  }
+  const mpmc_b4l ni = __builtin_convertvector(*(const mpmc_b4iu *)(p->xnode + q), mpmc_b4l);
+  memcpy(t->node0, &ni, sizeof ni);
+}
+MPMC_ALWAYS_INLINE void mpmc_kept_weights1(const int DIM, const int BASIS, const mpmc_grid *g,
+                                           const mpmc_particles *p, int q, mpmc_pw4 *t) {
+  for (int a = 0; a < DIM; ++a) {
+    double w[MPMC_MAX_STENCIL];
+    mpmc_basis_1d_at(BASIS, p->xoff[(size_t)a * (size_t)p->cap + (size_t)q],
+                     BASIS == MPMC_BASIS_UGIMP ? p->lp[q] * g->inv_h : 0.0, w);
+    for (int k = 0; k < mpmc_stencil(BASIS); ++k) t->w[a][k][0] = w[k];
+  }
+  t->node0[0] = p->xnode[q];
+}
+
+/* Where G2P keeps the weights for F-bar's gather (above): the particles' xoff, axis by
+ * axis, and xnode, taken once before a kernel's loops */
+typedef struct {
+  double *off[3];
+  int *node;
+} mpmc_keep;
+MPMC_ALWAYS_INLINE mpmc_keep mpmc_keep_of(mpmc_particles *p) {
+  const size_t cap = (size_t)p->cap;
+  mpmc_keep k = {{NULL, NULL, NULL}, p->xnode};
+  for (int a = 0; a < p->dim && p->xoff; ++a) k.off[a] = p->xoff + (size_t)a * cap;
+  return k;
+}
+
+/* What G2P keeps for the gather of the points idx[0 .. nb - 1], t's lanes (SEQ: consecutive
+ * points, a batch of four stored as whole vectors). */
+MPMC_ALWAYS_INLINE void mpmc_keep_weights(const int DIM, const mpmc_keep *k, const mpmc_pw4 *t,
+                                          const int *idx, int nb, const int SEQ) {
+  if (SEQ && nb == 4) {
+    for (int a = 0; a < DIM; ++a)
+      *(mpmc_b4du *)(k->off[a] + idx[0]) = *(const mpmc_b4da *)t->off[a];
+    mpmc_b4l n0;
+    memcpy(&n0, t->node0, sizeof n0);
+    *(mpmc_b4iu *)(k->node + idx[0]) = __builtin_convertvector(n0, mpmc_b4iu);
+  } else {
+    for (int l = 0; l < nb; ++l) {
+      for (int a = 0; a < DIM; ++a) k->off[a][idx[l]] = t->off[a][l];
+      k->node[idx[l]] = (int)t->node0[l];
+    }
+  }
+}
 
 /* det of a dim x dim row-major matrix (the relative deformation gradient) */
 MPMC_ALWAYS_INLINE double mpmc_det_dim(const int DIM, const double *F) {
@@ -210,7 +280,7 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights4(const int DIM, const int BASIS, con
                          x[(size_t)idx[2] * DIM + a], x[(size_t)idx[3] * DIM + a]};
     const mpmc_b4d s = (xv - g->origin[a]) * g->inv_h, sh = MPMC_STABLE_ARG(BASIS, s);
     mpmc_b4i b;
-    mpmc_poly_lanes(mpmc_stable_basis(BASIS), &sh, 1.0, &b, (mpmc_b4da *)sp->w[a], NULL);
+    mpmc_poly_lanes(mpmc_stable_basis(BASIS), &sh, 1.0, &b, (mpmc_b4da *)sp->w[a], NULL, NULL);
     b = MPMC_STABLE_NODE(BASIS, b);
     node0 += (long long)str * __builtin_convertvector(b, mpmc_b4l);
     sp->st[a] = str * (size_t)mpmc_stable_step(BASIS);
