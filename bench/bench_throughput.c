@@ -13,9 +13,10 @@
  * cost.  With MPMC_BENCH_PHASES set each row is followed by the share of the step's wall time
  * per phase (mpmc_stats.phase_seconds) of its last run.  With MPMC_BENCH_SHARE=R set, the
  * table (none with a case beyond it, e.g. 99) is followed by F-bar's share of the standard
- * step on the column, one thread: the steps without and with each form (linear, B-spline2 and
- * uGIMP with Algorithm 1; B-spline2 and uGIMP with the stable form; the linear basis is the
- * issue's reference column's) run alternately for R rounds in this one process, and each round's
+ * step on the column, one thread: the steps without and with each form (linear, B-spline2,
+ * uGIMP and cubic B-splines with Algorithm 1; B-spline2 and uGIMP with the stable form; the
+ * linear basis is the issue's reference column's) run alternately for R rounds in this one
+ * process, and each round's
  * share is rate(off) / rate(on) - 1 of its adjacent pair (the machine's drift, slow against a
  * round, cancels in a pair).  Printed per form: the median and range of the R shares; the
  * share from the best rate of each (the runs least disturbed by other load, on a busy host
@@ -153,6 +154,7 @@ static void fbar_shares(int rounds, int steps, double scale) {
   } forms[] = {{MPMC_BASIS_LINEAR, MPMC_FBAR_PAPER, "linear paper"},
                {MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, "bspline2 paper"},
                {MPMC_BASIS_UGIMP, MPMC_FBAR_PAPER, "ugimp paper"},
+               {MPMC_BASIS_BSPLINE3, MPMC_FBAR_PAPER, "bspline3 paper"},
                {MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, "bspline2 stable"},
                {MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, "ugimp stable"}};
   enum { NF = sizeof forms / sizeof forms[0] };
