@@ -393,19 +393,21 @@ int mpmc_sim_prepare(mpmc_sim sim) {
     for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
   }
   /* x^n for the gather (fbar.c): as positions for the stable form, as the weights' offsets
-   * and first nodes for the others (transfer.h, mpmc_kept_weights4); the other's freed */
-  double **xkeep = sim->fbar == MPMC_FBAR_STABLE ? &p->xn : &p->xoff;
-  if (sim->fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, xkeep, d, 0.0));
-  if (sim->fbar && sim->fbar != MPMC_FBAR_STABLE && !p->xnode) {
-    p->xnode = calloc((size_t)p->cap, sizeof(int));
-    MPMC_CHECK(p->xnode, ctx, MPMC_ERR_MEMORY, "cannot allocate a particle field for %d points",
-               p->cap);
-  }
-  if (sim->fbar != MPMC_FBAR_STABLE) {
+   * and first nodes for the others (transfer.h, mpmc_kept_weights4); what the form does not
+   * use is freed */
+  const int keep_x = sim->fbar == MPMC_FBAR_STABLE, keep_w = sim->fbar && !keep_x;
+  if (keep_x) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->xn, d, 0.0));
+  } else {
     free(p->xn);
     p->xn = NULL;
   }
-  if (sim->fbar == MPMC_FBAR_OFF || sim->fbar == MPMC_FBAR_STABLE) {
+  if (keep_w) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->xoff, d, 0.0));
+    if (!p->xnode) p->xnode = calloc((size_t)p->cap, sizeof(int));
+    MPMC_CHECK(p->xnode, ctx, MPMC_ERR_MEMORY, "cannot allocate a particle field for %d points",
+               p->cap);
+  } else {
     free(p->xoff);
     free(p->xnode);
     p->xoff = NULL;
