@@ -17,10 +17,10 @@
  * uGIMP and cubic B-splines with Algorithm 1; B-spline2 and uGIMP with the stable form; the
  * linear basis is the issue's reference column's) run alternately for R rounds in this one
  * process, and each round's share is rate(off) / rate(on) - 1 of its adjacent pair (the
- * machine's drift, slow against a round, cancels in a pair).  Printed per form: the median and range of the R shares; the
- * share from the best rate of each (the runs least disturbed by other load, on a busy host
- * the steadier figure); each phase's least ms a step over the rounds, off and on, and their
- * sums' ratio (each phase at its least disturbed round). */
+ * machine's drift, slow against a round, cancels in a pair).  Printed per form: the median
+ * and range of the R shares; the share from the best rate of each (the runs least disturbed
+ * by other load, on a busy host the steadier figure); each phase's least ms a step over the
+ * rounds, off and on, and their sums' ratio (each phase at its least disturbed round). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
