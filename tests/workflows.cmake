@@ -20,7 +20,7 @@ foreach(scene ${MPMC_SCENES})
   set_tests_properties(scene-${sname} PROPERTIES LABELS workflow
     ENVIRONMENT "OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
 endforeach()
-foreach(t IN ITEMS t650-workflow-scene-errors t651-workflow-run t652-workflow-rigid)
+foreach(t IN ITEMS t650-workflow-scene-errors t651-workflow-run t652-workflow-rigid t660-workflow-resume)
   if(TARGET ${t})
     target_link_libraries(${t} PRIVATE mpmc_workflow)
     target_compile_definitions(${t} PRIVATE MPMC_CLI="$<TARGET_FILE:mpmc_cli>")

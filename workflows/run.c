@@ -32,6 +32,17 @@ typedef struct {
   const char *reason;
 } stage_record;
 
+/* Where a stage stands between two steps: what a checkpoint inside the stage records so that
+ * the resumed stage takes the same steps as the uninterrupted one (the step size is computed
+ * every 10 steps counted from the stage's start, and kept in between; the next series row and
+ * snapshot are running sums). */
+typedef struct {
+  double t_stage;     /* time into the stage                                            */
+  double dt;          /* the step last computed (0: compute it on the next step)        */
+  double ke, ke_max, ratio;   /* kinetic energy, its stage maximum, their ratio         */
+  double next_series, next_snap; /* stage times of the next row and snapshot (0: derive) */
+} stage_clock;
+
 typedef struct {
   mpmc_context ctx;
   wf_scene sc;
@@ -54,6 +65,7 @@ typedef struct {
   int ckpt_ok;             /* a checkpoint (the last good state) has been written           */
   double ckpt_time;        /* its simulated time                                          */
   int resumed;             /* outputs are the _resumed files                              */
+  int series_rows;         /* data rows series.csv holds from before a resume            */
 } wf_run;
 
 /* `threads` applies to every parallel region of the run (the step and the reductions the
@@ -394,14 +406,20 @@ static int snapshot(wf_run *w) {
 }
 
 #ifdef MPMC_WF_HAVE_CHECKPOINT
-static int checkpoint(wf_run *w, int stage, double t_stage, long steps, double ke_max, int setup_done) {
+/* At the start of `stage` (c == NULL: before its setup) or inside it (c: where it stands). */
+static int checkpoint(wf_run *w, int stage, const stage_clock *c, long steps) {
   char path[WF_PATH], meta[16384], scene[WF_PATH];
+  const stage_clock c0 = {0};
+  const int setup_done = c != NULL;
+  if (!c) c = &c0;
   out_path(w, "checkpoint.h5", path, sizeof path);
   /* the absolute path, so that `mpmc resume` works from any directory */
   if (!realpath(w->sc.path, scene)) snprintf(scene, sizeof scene, "%s", w->sc.path);
   size_t l = (size_t)snprintf(meta, sizeof meta, "mpmc-workflow 1\nscene %s\nstage %d\nsetup %d\nstage_time %.17g\n"
-                              "stage_steps %ld\nke_max %.17g\nke_below %.17g\nstrength %.17g\n", scene, stage, setup_done,
-                              t_stage, steps, ke_max, setup_done ? w->ke_below : -1.0, w->strength);
+                              "stage_steps %ld\nke_max %.17g\nke_below %.17g\nstrength %.17g\ndt %.17g\nke %.17g\n"
+                              "ratio %.17g\nnext_series %.17g\nnext_snap %.17g\n", scene, stage, setup_done,
+                              c->t_stage, steps, c->ke_max, setup_done ? w->ke_below : -1.0, w->strength, c->dt, c->ke,
+                              c->ratio, c->next_series, c->next_snap);
   for (int i = 0; i < w->noverride && l < sizeof meta; ++i)
     l += (size_t)snprintf(meta + l, sizeof meta - l, "set %s\n", w->overrides[i]);
   for (int i = 0; i < w->nwall_ids && l < sizeof meta; ++i)
@@ -438,7 +456,6 @@ static int step_failed(wf_run *w, int e, const wf_stage *s, double t, long steps
   return fail(w, e, "stage '%s' at t = %.6g s (step %ld): %s%s", s->name, t, steps, lib, note);
 }
 
-/* Run stage i from t_stage (0 unless resuming). */
 /* The quasi-static end test, checked every 10 steps: E_k/E_k,max <= tol must hold at every
  * check for a while, not just once.  A slow oscillation (Cook's membrane under its dead load
  * swings with a period of ~60 s) passes through E_k = 0 at each turning point: a single
@@ -457,7 +474,8 @@ static int wf_quasi_static(double ratio, double tol, double t_stage, double min_
   return t_stage - *below >= fmax(0.05 * t_stage, 50.0 * dt);
 }
 
-static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_max, wf_progress *pr) {
+/* Run stage i, from its start (from == NULL) or from where a checkpoint left it. */
+static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf_progress *pr) {
   long steps = *nsteps;
   const wf_scene *sc = &w->sc;
   const wf_stage *s = &sc->stages[i];
@@ -466,21 +484,28 @@ static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_m
   snprintf(rec->name, sizeof rec->name, "%s", s->name);
   const double T = s->end_time; /* quasi-static: the maximum time */
   const double w0 = wf_now();
-  double last_ckpt = w0, dt = s->dt, ke = 0.0, ratio = 1.0, t0;
+  stage_clock c = {.dt = s->dt, .ratio = 1.0};
+  if (from && from->t_stage > 0) c = *from;
+  double t_stage = c.t_stage, dt = s->dt > 0 ? s->dt : c.dt, ke = c.ke, ke_max = c.ke_max, ratio = c.ratio;
+  double last_ckpt = w0, t0;
   mpmc_sim_get_time(sim, &t0);
   t0 -= t_stage;
   const double every_series = T / s->series_points;
   const double every_snap = s->snapshots > 0 ? T / (s->snapshots + 1) : INFINITY;
-  double next_series = every_series * floor(t_stage / every_series + 1e-9);
-  double next_snap = every_snap * (floor(t_stage / every_snap + 1e-9) + 1);
+  /* a checkpoint of before these were recorded: the next ones from the stage time */
+  double next_series = c.next_series > 0 ? c.next_series : every_series * floor(t_stage / every_series + 1e-9);
+  double next_snap = c.next_snap > 0 ? c.next_snap : every_snap * (floor(t_stage / every_snap + 1e-9) + 1);
   const char *reason = NULL;
-  long s0 = steps;
+  /* the steps are counted from the stage's start, also when resumed inside it: the step size
+   * is recomputed on the same steps as in the uninterrupted run */
+  long s0 = 0, s_run = steps;
+  for (int j = 0; j < i; ++j) s0 += w->rec[j].steps;
   (void)last_ckpt;
   char spmsg[WF_MSG] = ""; /* snapshot plots at given times (snapshot_plots.c) */
   if (t_stage == 0 && wf_snapplots_step(sim, sc, w->out, i, -1.0, 0.0, spmsg, sizeof spmsg))
     return fail(w, MPMC_ERR_IO, "%s", spmsg);
   while (!reason) {
-    if (s->dt <= 0 && (steps - s0) % 10 == 0)
+    if (s->dt <= 0 && ((steps - s0) % 10 == 0 || dt <= 0))
       WF_TRY(w, mpmc_sim_stable_dt(sim, s->dt_factor, &dt), "stages.%d: time step", i);
     double h = dt;
     if (t_stage + h > T) h = T - t_stage; /* land on the stage's end */
@@ -525,11 +550,12 @@ static int run_stage(wf_run *w, int i, double t_stage, long *nsteps, double ke_m
       while (next_snap <= t_stage) next_snap += every_snap;
     }
     const double now = wf_now();
-    const double rate = (double)(steps - s0) / fmax(now - w0, 1e-9);
+    const double rate = (double)(steps - s_run) / fmax(now - w0, 1e-9);
     if (!w->quiet) wf_progress_update(pr, sc, i, t_stage, T, steps, rate, sc->progress_interval, reason != NULL);
 #ifdef MPMC_WF_HAVE_CHECKPOINT
     if (!reason && now - last_ckpt > sc->checkpoint_interval) {
-      if (checkpoint(w, i, t_stage, steps, ke_max, 1)) return -1;
+      const stage_clock here = {t_stage, dt, ke, ke_max, ratio, next_series, next_snap};
+      if (checkpoint(w, i, &here, steps)) return -1;
       last_ckpt = now;
     }
 #endif
@@ -626,12 +652,62 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
   fclose(f);
 }
 
+/* Resuming: series.csv back to the checkpoint, the rows of at most `steps` steps (a killed
+ * run wrote rows after its last checkpoint, and maybe half a row), through a temporary file
+ * renamed over it.  *kept: the data rows left.  The step is the third field; stage names may
+ * hold commas, so it is found from the end of the row (dt, E_k, ratio and the metrics after
+ * it). */
+static int trim_series(wf_run *w, long steps, int *kept) {
+  char path[WF_PATH], tmp[WF_PATH + 8];
+  out_path(w, "series.csv", path, sizeof path);
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  *kept = 0;
+  FILE *in = fopen(path, "r");
+  if (!in) return errno == ENOENT ? 0 : fail(w, MPMC_ERR_IO, "cannot read %s: %s", path, strerror(errno));
+  FILE *out = fopen(tmp, "w");
+  if (!out) {
+    fclose(in);
+    return fail(w, MPMC_ERR_IO, "cannot write %s: %s", tmp, strerror(errno));
+  }
+  int after = 3; /* fields after the step */
+  for (int k = 0; k < WF_METRIC_COUNT; ++k) after += w->sc.metrics.enabled[k];
+  char *line = NULL;
+  size_t cap = 0;
+  ssize_t n;
+  for (long row = 0; (n = getline(&line, &cap, in)) > 0; ++row) {
+    if (line[n - 1] != '\n') break; /* cut by the kill */
+    int keep = row == 0;            /* the header */
+    if (!keep) {
+      int commas = 0;
+      char *p = line + n - 1;
+      while (p > line && commas < after) commas += *--p == ',';
+      char *end = p; /* the comma after the step */
+      while (p > line && p[-1] != ',') --p;
+      char *stop = NULL;
+      const long st = commas == after && p > line ? strtol(p, &stop, 10) : -1;
+      keep = stop == end && st >= 0 && st <= steps;
+      *kept += keep;
+    }
+    if (keep) fputs(line, out);
+  }
+  free(line);
+  fclose(in);
+  int bad = fflush(out) != 0;
+  bad |= ferror(out) != 0;
+  bad |= fclose(out) != 0;
+  if (bad || rename(tmp, path)) {
+    remove(tmp);
+    return fail(w, MPMC_ERR_IO, "cannot rewrite %s: %s", path, strerror(errno));
+  }
+  return 0;
+}
+
 static int open_outputs(wf_run *w, int append) {
   char path[WF_PATH], xpath[WF_PATH];
   out_path(w, "series.csv", path, sizeof path);
   w->series = fopen(path, append ? "a" : "w");
   if (!w->series) return fail(w, MPMC_ERR_IO, "cannot write %s: %s", path, strerror(errno));
-  if (!append) {
+  if (!append || fseek(w->series, 0, SEEK_END) || ftell(w->series) == 0) { /* new, or none to append to */
     fputs("stage,time,step,dt,kinetic_energy,ke_ratio", w->series);
     for (int k = 0; k < WF_METRIC_COUNT; ++k)
       if (w->sc.metrics.enabled[k]) fprintf(w->series, ",%s", wf_metric_names[k]);
@@ -644,24 +720,29 @@ static int open_outputs(wf_run *w, int append) {
   return 0;
 }
 
-static int run_all(wf_run *w, int first_stage, double t_stage, long steps, double ke_max, int setup_done) {
+/* From the start of first_stage (from == NULL), or inside it: from->t_stage > 0, or at its
+ * start once set up (setup_done: a checkpoint inside the stage, or the last stage of a
+ * finished run going on to a later end) */
+static int run_all(wf_run *w, int first_stage, const stage_clock *from, long steps, int setup_done) {
+  const double t_stage = from ? from->t_stage : 0.0;
   wf_progress pr;
   wf_progress_init(&pr);
   if (first_stage == 0 && t_stage == 0 && snapshot(w)) return -1;
 #ifdef MPMC_WF_HAVE_CHECKPOINT
   /* the last good state exists from the start: a failure in the first stage keeps it */
-  if (first_stage == 0 && t_stage == 0 && !setup_done && checkpoint(w, 0, 0, steps, 0, 0)) return -1;
+  if (first_stage == 0 && t_stage == 0 && !setup_done && checkpoint(w, 0, NULL, steps)) return -1;
 #endif
   for (int i = first_stage; i < w->sc.nstage; ++i) {
     if (!(i == first_stage && setup_done) && stage_setup(w, i)) return -1;
-    if (i == first_stage && t_stage == 0 && series_row(w, i, steps, 0, 0, 1)) return -1;
+    /* the state the run starts from; a resumed run has it unless killed before writing it */
+    if (i == 0 && t_stage == 0 && !setup_done && w->series_rows == 0 && series_row(w, i, steps, 0, 0, 1)) return -1;
     if (!(i == first_stage && t_stage > 0)) w->ke_below = -1.0; /* else restored from the checkpoint */
-    if (run_stage(w, i, i == first_stage ? t_stage : 0, &steps, i == first_stage ? ke_max : 0, &pr)) return -1;
+    if (run_stage(w, i, i == first_stage ? from : NULL, &steps, &pr)) return -1;
 #ifdef MPMC_WF_HAVE_CHECKPOINT
     /* at the start of the next stage; after the last one, the finished run (stage = nstage),
      * which `mpmc resume` continues once the scene has another stage: that one only warns
      * when it cannot be written, the run itself is done and its outputs follow */
-    if (checkpoint(w, i + 1, 0, steps, 0, 0)) {
+    if (checkpoint(w, i + 1, NULL, steps)) {
       if (i + 1 < w->sc.nstage) return -1;
       say(w, "warning: the final checkpoint: %s (the run is complete; it cannot be extended by `mpmc resume`)",
           mpmc_context_last_error(w->ctx));
@@ -766,7 +847,7 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
   if (mkdir_p(w.out)) return finish(&w, fail(&w, MPMC_ERR_IO, "cannot create '%s': %s", w.out, strerror(errno)));
   say(&w, "output: %s", w.out);
   if (open_outputs(&w, 0)) return finish(&w, ctx->last_code);
-  const int err = run_all(&w, 0, 0, 0, 0, 0);
+  const int err = run_all(&w, 0, NULL, 0, 0);
   return finish(&w, err ? ctx->last_code : 0);
 }
 
@@ -803,7 +884,8 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   /* parse the workflow's record */
   char scene[WF_PATH] = "";
   int stage = -1, setup = 0, nset = 0, nwall = 0, ndone = 0;
-  double t_stage = 0, ke_max = 0, strength = 1, ke_below = -1;
+  double strength = 1, ke_below = -1;
+  stage_clock clock = {.ratio = 1.0};
   long steps = 0;
   char **sets = calloc(1, sizeof *sets);
   int *walls = NULL;
@@ -814,9 +896,12 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     if (!strncmp(line, "scene ", 6))
       snprintf(scene, sizeof scene, "%s", line + 6);
     else if (sscanf(line, "stage %d", &stage) == 1 || sscanf(line, "setup %d", &setup) == 1 ||
-             sscanf(line, "stage_time %lf", &t_stage) == 1 || sscanf(line, "stage_steps %ld", &steps) == 1 ||
-             sscanf(line, "ke_max %lf", &ke_max) == 1 || sscanf(line, "strength %lf", &strength) == 1 ||
-             sscanf(line, "ke_below %lf", &ke_below) == 1)
+             sscanf(line, "stage_time %lf", &clock.t_stage) == 1 || sscanf(line, "stage_steps %ld", &steps) == 1 ||
+             sscanf(line, "ke_max %lf", &clock.ke_max) == 1 || sscanf(line, "strength %lf", &strength) == 1 ||
+             sscanf(line, "ke_below %lf", &ke_below) == 1 || sscanf(line, "dt %lf", &clock.dt) == 1 ||
+             sscanf(line, "ke %lf", &clock.ke) == 1 || sscanf(line, "ratio %lf", &clock.ratio) == 1 ||
+             sscanf(line, "next_series %lf", &clock.next_series) == 1 ||
+             sscanf(line, "next_snap %lf", &clock.next_snap) == 1)
       continue;
     else if (!strncmp(line, "set ", 4)) {
       char **s2 = realloc(sets, sizeof *sets * (size_t)(nset + 1));
@@ -873,11 +958,12 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     const wf_stage *last = &w.sc.stages[stage - 1];
     const stage_record *r = &done[stage - 1];
     if (strcmp(r->reason, "quasi_static") != 0 && last->end_time > r->sim_time * (1 + 1e-9)) {
-      t_stage = r->sim_time; /* the last stage again, at its old end, set up */
+      /* the last stage again, at its old end, set up; ke_max is used by quasi-static ends
+       * only, the step size is computed on the first step */
+      clock = (stage_clock){.t_stage = r->sim_time, .ratio = 1.0};
       --stage;
       --ndone;
       setup = 1;
-      ke_max = 0.0; /* used by quasi-static ends only */
       ke_below = -1.0;
     } else {
       char how[WF_PATH + 160] = "";
@@ -913,12 +999,13 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     sim = NULL;
     if (wf_metrics_init(w.sim, &w.sc)) err = ctx->last_code;
     say(&w, "resuming %s at stage %d/%d (%s), %.4g s into it", scene, stage + 1, w.sc.nstage,
-        w.sc.stages[stage].name, t_stage);
+        w.sc.stages[stage].name, clock.t_stage);
+    if (!err) err = trim_series(&w, steps, &w.series_rows) ? ctx->last_code : 0;
     if (!err) err = open_outputs(&w, 1) ? ctx->last_code : 0;
     if (!err) {
       if (setup && w.sc.stages[stage].has_gravity) mpmc_sim_set_gravity(w.sim, w.sc.stages[stage].gravity);
       if (setup) mpmc_sim_set_damping(w.sim, w.sc.stages[stage].damping);
-      err = run_all(&w, stage, t_stage, steps, ke_max, setup) ? ctx->last_code : 0;
+      err = run_all(&w, stage, &clock, steps, setup) ? ctx->last_code : 0;
     }
   }
   mpmc_sim_destroy(&sim);
