@@ -10,7 +10,10 @@
  *   checkpoint are trimmed on resume.
  * - Killed in the second stage before a checkpoint inside it, the run resumes from the
  *   checkpoint at that stage's start, again to the same bits and the same series.csv (no
- *   row of zero energy at the stage's start). */
+ *   row of zero energy at the stage's start).
+ * - `mpmc run --force` into a directory of an earlier run removes that run's files (the
+ *   resumed snapshots, snapshot-plot data, a stale checkpoint) and nothing else: a file of
+ *   the user's, one with a near name and a subdirectory stay. */
 #include <setjmp.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -260,10 +263,53 @@ static void test_resume_stage_start(void **state) {
   expect_same_series(DIR "/ref/series.csv", DIR "/kill2/series.csv", "after a kill and a resume from a stage's start");
 }
 
+static int exists(const char *p) {
+  struct stat s;
+  return stat(p, &s) == 0;
+}
+
+static void test_force(void **state) {
+  (void)state;
+  const char *scene = DIR "/fall.yaml";
+  write_text(scene,
+             "scene: fall\ndim: 2\ngrid: {lo: [0, -1], hi: [2, 2], cell_size: 0.5}\nfbar: false\nplots: false\n"
+             "materials:\n  m: {model: hencky, E: 1.0e6, nu: 0.3, rho: 1000}\n"
+             "geometry:\n  - {type: box, lo: [0, 0], hi: [1, 1], ppc: 2}\n"
+             "stages:\n  - {name: only, gravity: [0, -9.81], dt: 0.001, end: {time: 0.005}}\n");
+  assert_int_equal(system("rm -rf '" DIR "/force' && mkdir -p '" DIR "/force/mine'"), 0);
+  static const char *const old[] = {"summary.json", "snapshots_resumed.h5", "snapshots_resumed.xdmf",
+                                    "checkpoint.h5.tmp", "snap_gone_t1_speed.csv", "snapshot_gone_t1_speed.png",
+                                    "snapshots_gone_speed.png", "final_eps_p.png", "bearing.png"};
+  static const char *const mine[] = {"notes.txt", "series.csv.bak", "snap.csv", "mine/summary.json"};
+  char path[512];
+  for (size_t i = 0; i < sizeof old / sizeof old[0]; ++i) {
+    snprintf(path, sizeof path, "%s/force/%s", DIR, old[i]);
+    write_text(path, "from an earlier run\n");
+  }
+  for (size_t i = 0; i < sizeof mine / sizeof mine[0]; ++i) {
+    snprintf(path, sizeof path, "%s/force/%s", DIR, mine[i]);
+    write_text(path, "the user's\n");
+  }
+  if (wait_cli(spawn_cli("run", scene, "--out", DIR "/force", "--force", "--quiet", NULL)) != 0)
+    fail_msg("mpmc run --force failed (see %s/cli.log)", DIR);
+  for (size_t i = 1; i < sizeof old / sizeof old[0]; ++i) {
+    snprintf(path, sizeof path, "%s/force/%s", DIR, old[i]);
+    if (exists(path)) fail_msg("mpmc run --force left the earlier run's %s", path);
+  }
+  for (size_t i = 0; i < sizeof mine / sizeof mine[0]; ++i) {
+    snprintf(path, sizeof path, "%s/force/%s", DIR, mine[i]);
+    if (!exists(path)) fail_msg("mpmc run --force removed %s, a file the run does not write", path);
+  }
+  char *sum = slurp(DIR "/force/summary.json");
+  if (!strstr(sum, "\"completed\"")) fail_msg("summary.json of the forced run: %s", sum);
+  free(sum);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_resume_mid_stage),
       cmocka_unit_test(test_resume_stage_start),
+      cmocka_unit_test(test_force),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -152,6 +152,49 @@ static void out_path(const wf_run *w, const char *name, char *buf, size_t len) {
   snprintf(buf, len, "%s/%s", w->out, name);
 }
 
+/* Does `name` start with pre and end with suf (with something between)? */
+static int named(const char *name, const char *pre, const char *suf) {
+  const size_t n = strlen(name), p = strlen(pre), s = strlen(suf);
+  return n > p + s && !strncmp(name, pre, p) && !strcmp(name + n - s, suf);
+}
+
+/* Is `name` a file a run writes into its output directory (docs/workflows.md, "Outputs")? */
+static int run_output(const char *name) {
+  static const char *const files[] = {"summary.json", "series.csv", "snapshots.h5", "snapshots.xdmf",
+                                      "snapshots_resumed.h5", "snapshots_resumed.xdmf", "checkpoint.h5",
+                                      "final_state.csv", "final_mean_stress.png", "final_eps_p.png", "series.png",
+                                      "bearing.png", "plots.log", "snapshot_plots.log", NULL};
+  for (int i = 0; files[i]; ++i) {
+    const size_t l = strlen(files[i]);
+    /* the file, or the temporary one it is written through (series.csv.tmp, checkpoint.h5.tmp,
+     * snapshots.xdmf.tmp) */
+    if (!strncmp(name, files[i], l) && (!name[l] || !strcmp(name + l, ".tmp"))) return 1;
+  }
+  /* snapshot_plots: snap_<stage>_t<time>_<colour>.csv, snapshot_<stage>_t<time>_<colour>.png,
+   * snapshots_<stage>_<colour>.png */
+  return named(name, "snap_", ".csv") || named(name, "snapshot_", ".png") || named(name, "snapshots_", ".png");
+}
+
+/* --force: remove the files an earlier run left in the output directory, so that none of them
+ * passes for this run's; only those names (never the directory, nor a file the run does not
+ * write). */
+static int remove_old_outputs(wf_run *w) {
+  DIR *d = opendir(w->out);
+  if (!d) return fail(w, MPMC_ERR_IO, "cannot read '%s': %s", w->out, strerror(errno));
+  struct dirent *e;
+  int err = 0;
+  while (!err && (e = readdir(d))) {
+    char path[WF_PATH];
+    struct stat st;
+    if (!run_output(e->d_name)) continue;
+    out_path(w, e->d_name, path, sizeof path);
+    if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && remove(path) != 0)
+      err = fail(w, MPMC_ERR_IO, "--force: cannot remove the old output '%s': %s", path, strerror(errno));
+  }
+  closedir(d);
+  return err;
+}
+
 /* ---- set-up ---------------------------------------------------------------------------- */
 static int build(wf_run *w) {
   wf_scene *sc = &w->sc;
@@ -845,6 +888,7 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
     return finish(&w, 0);
   }
   if (mkdir_p(w.out)) return finish(&w, fail(&w, MPMC_ERR_IO, "cannot create '%s': %s", w.out, strerror(errno)));
+  if ((flags & MPMC_WORKFLOW_FORCE) && remove_old_outputs(&w)) return finish(&w, ctx->last_code);
   say(&w, "output: %s", w.out);
   if (open_outputs(&w, 0)) return finish(&w, ctx->last_code);
   const int err = run_all(&w, 0, NULL, 0, 0);
