@@ -41,10 +41,6 @@ static double wave_speed(void) {
   return sqrt((K + 4.0 / 3.0 * G) / RHO);
 }
 
-static void expect_in(const char *what, const char *msg, const char *part) {
-  if (!strstr(msg, part)) fail_msg("%s: expected the message to contain \"%s\", got \"%s\"", what, part, msg);
-}
-
 /* small velocities that vary from point to point (a deterministic pattern) */
 static void perturb(mpmc_sim sim, int np, double amp) {
   double *v;
@@ -68,10 +64,10 @@ static void test_dt_refused(void **state) {
   int e = mpmc_sim_step(sim, 2 * limit);
   if (e != MPMC_ERR_UNSTABLE) fail_msg("dt = 2 h/c: expected MPMC_ERR_UNSTABLE (%d), got %d", MPMC_ERR_UNSTABLE, e);
   const char *msg = mpmc_context_last_error(ctx);
-  expect_in("dt refused", msg, "exceeds the stability limit");
+  test_expect_in("dt refused", msg, "exceeds the stability limit");
   char lim[64];
   snprintf(lim, sizeof lim, "= %g (h = %g)", limit, H);
-  expect_in("dt refused", msg, lim);
+  test_expect_in("dt refused", msg, lim);
   double t;
   TCALL(mpmc_sim_get_time(sim, &t));
   if (t != 0.0) fail_msg("a refused step advanced the time to %g, expected 0", t);
@@ -157,12 +153,12 @@ static void test_energy_stop(void **state) {
   if (e != MPMC_ERR_UNSTABLE)
     fail_msg("expected the energy check to stop the run (MPMC_ERR_UNSTABLE = %d), got %d after %d steps: %s",
              MPMC_ERR_UNSTABLE, e, steps, msg);
-  expect_in("energy stop", msg, "kinetic energy grows without input");
-  expect_in("energy stop", msg, "fastest point ");
-  expect_in("energy stop", msg, " at (");
+  test_expect_in("energy stop", msg, "kinetic energy grows without input");
+  test_expect_in("energy stop", msg, "fastest point ");
+  test_expect_in("energy stop", msg, " at (");
   char st[32];
   snprintf(st, sizeof st, "step %d,", steps);
-  expect_in("energy stop", msg, st);
+  test_expect_in("energy stop", msg, st);
   /* stopped early: positions, velocities and stresses are all finite */
   double *x, *v, *s;
   TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL));
@@ -245,8 +241,8 @@ static void test_leaves_grid(void **state) {
   }
   const char *msg = mpmc_context_last_error(ctx);
   if (e != MPMC_ERR_OUTSIDE) fail_msg("expected MPMC_ERR_OUTSIDE (%d), got %d: %s", MPMC_ERR_OUTSIDE, e, msg);
-  expect_in("outside", msg, "left the grid box at (");
-  expect_in("outside", msg, "point ");
+  test_expect_in("outside", msg, "left the grid box at (");
+  test_expect_in("outside", msg, "point ");
   /* the block's right edge started at 1.5 and moves at 20 m/s: it leaves the box
    * (2 m + one cell of drift) after about (2.25 - 1.5) / 20 s */
   double t;
@@ -274,8 +270,8 @@ static void test_nan_velocity(void **state) {
   const char *msg = mpmc_context_last_error(ctx);
   if (e != MPMC_ERR_NUMERIC && e != MPMC_ERR_OUTSIDE)
     fail_msg("NaN velocity: expected MPMC_ERR_NUMERIC or MPMC_ERR_OUTSIDE, got %d: %s", e, msg);
-  expect_in("NaN velocity", msg, "step 0, t = 0: point ");
-  expect_in("NaN velocity", msg, "nan");
+  test_expect_in("NaN velocity", msg, "step 0, t = 0: point ");
+  test_expect_in("NaN velocity", msg, "nan");
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
 }
@@ -289,7 +285,7 @@ static void test_bad_factor(void **state) {
   mpmc_sim sim = block(ctx, &np);
   int e = mpmc_sim_set_energy_monitor(sim, 0.5);
   if (e != MPMC_ERR_ARG) fail_msg("factor 0.5: expected MPMC_ERR_ARG, got %d", e);
-  expect_in("factor", mpmc_context_last_error(ctx), "energy monitor factor = 0.5 must be > 1");
+  test_expect_in("factor", mpmc_context_last_error(ctx), "energy monitor factor = 0.5 must be > 1");
   e = mpmc_sim_set_energy_monitor(sim, NAN);
   if (e != MPMC_ERR_ARG) fail_msg("factor NaN: expected MPMC_ERR_ARG, got %d", e);
   if (mpmc_sim_set_energy_monitor(NULL, 2) != MPMC_ERR_ARG) fail_msg("NULL sim: expected MPMC_ERR_ARG");

@@ -14,19 +14,6 @@
 #define H5 MPMC_BINARY_DIR "/t601-out.h5"
 #define XDMF MPMC_BINARY_DIR "/t601-out.xdmf"
 
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) fail_msg("expected to open %s", path);
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  if (fread(s, 1, (size_t)n, f) != (size_t)n) fail_msg("short read of %s", path);
-  s[n] = '\0';
-  fclose(f);
-  return s;
-}
-
 static void read_doubles(hid_t file, const char *path, double *buf) {
   hid_t ds = H5Dopen2(file, path, H5P_DEFAULT);
   if (ds < 0) fail_msg("expected dataset %s", path);
@@ -65,7 +52,7 @@ static void test_snapshots(void **state) {
   TCALL(mpmc_output_destroy(&out));
   assert_null(out);
 
-  char *x = slurp(XDMF);
+  char *x = test_slurp(XDMF);
   /* three snapshots, in time order, with their times */
   int ngrid = 0;
   for (const char *p = x; (p = strstr(p, "<Time Value=\"")); ++ngrid) {

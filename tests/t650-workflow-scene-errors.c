@@ -7,7 +7,6 @@
 #include <stddef.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -54,27 +53,6 @@ static int run_lib(const char *scene, const char *out, int nset, const char *con
   return e;
 }
 
-/* Run the `mpmc` program; returns its exit status and its stderr in msg. */
-static int run_cli(const char *args, char *msg, size_t len) {
-  char cmd[2048];
-  snprintf(cmd, sizeof cmd, "'%s' %s 2>&1 >/dev/null", MPMC_CLI, args);
-  FILE *p = popen(cmd, "r");
-  assert_non_null(p);
-  const size_t n = fread(msg, 1, len - 1, p);
-  msg[n] = '\0';
-  const int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static void expect_in(const char *what, const char *msg, const char *part) {
-  if (!strstr(msg, part)) fail_msg("%s: expected the message to contain \"%s\", got \"%s\"", what, part, msg);
-}
-
-static int exists(const char *p) {
-  struct stat s;
-  return stat(p, &s) == 0;
-}
-
 /* One bad scene through the library and through the program; out must stay untouched. */
 static void check_bad(const char *name, const char *cell_line, const char *body, const char *where,
                       const char *key, const char *what) {
@@ -91,21 +69,21 @@ static void check_bad(const char *name, const char *cell_line, const char *body,
   if (e == 0) fail_msg("%s: expected a non-zero code, got 0", name);
   char loc[600];
   snprintf(loc, sizeof loc, "%s.yaml:%s", name, where);
-  expect_in(name, msg, loc);
-  expect_in(name, msg, key);
-  expect_in(name, msg, what);
+  test_expect_in(name, msg, loc);
+  test_expect_in(name, msg, key);
+  test_expect_in(name, msg, what);
   /* even with --force, a scene that does not load writes nothing */
   char sum[600];
   snprintf(sum, sizeof sum, "%s/summary.json", out);
-  if (exists(sum)) fail_msg("%s: expected no %s after a bad scene, found one", name, sum);
+  if (test_exists(sum)) fail_msg("%s: expected no %s after a bad scene, found one", name, sum);
   char args[1400];
   snprintf(args, sizeof args, "run '%s' --out '%s' --force", scene, out);
-  const int st = run_cli(args, msg, sizeof msg);
+  const int st = test_run_cli(args, msg, sizeof msg);
   if (st == 0) fail_msg("%s: expected a non-zero exit status from mpmc, got 0", name);
-  expect_in(name, msg, loc);
-  expect_in(name, msg, key);
-  if (exists(sum)) fail_msg("%s: the program wrote %s for a bad scene", name, sum);
-  if (!exists(marker)) fail_msg("%s: %s was removed", name, marker);
+  test_expect_in(name, msg, loc);
+  test_expect_in(name, msg, key);
+  if (test_exists(sum)) fail_msg("%s: the program wrote %s for a bad scene", name, sum);
+  if (!test_exists(marker)) fail_msg("%s: %s was removed", name, marker);
 }
 
 static void test_syntax_error(void **state) {
@@ -146,24 +124,24 @@ static void test_bad_override(void **state) {
   const char *sets[] = {"grid.cell_size=-2"};
   int e = run_lib(scene, DIR "/out-override", 1, sets, 0, msg, sizeof msg);
   if (e == 0) fail_msg("--set grid.cell_size=-2: expected a failure, got 0");
-  expect_in("--set", msg, "key 'grid.cell_size': must be > 0 (got -2)");
-  expect_in("--set", msg, "--set grid.cell_size=-2");
+  test_expect_in("--set", msg, "key 'grid.cell_size': must be > 0 (got -2)");
+  test_expect_in("--set", msg, "--set grid.cell_size=-2");
   const char *typo[] = {"grid.cell_sise=1"};
   e = run_lib(scene, DIR "/out-override", 1, typo, 0, msg, sizeof msg);
   if (e == 0) fail_msg("--set grid.cell_sise=1: expected a failure, got 0");
-  expect_in("--set typo", msg, "key 'grid.cell_sise': unknown key (did you mean 'cell_size'?)");
-  if (exists(DIR "/out-override")) fail_msg("a failed --set created the output directory");
+  test_expect_in("--set typo", msg, "key 'grid.cell_sise': unknown key (did you mean 'cell_size'?)");
+  if (test_exists(DIR "/out-override")) fail_msg("a failed --set created the output directory");
   const char *fb[] = {"fbar=stabel"};
   e = run_lib(scene, DIR "/out-override", 1, fb, 0, msg, sizeof msg);
   if (e == 0) fail_msg("--set fbar=stabel: expected a failure, got 0");
-  expect_in("--set fbar", msg, "key 'fbar': expected true, false, paper, total or stable (got 'stabel')");
+  test_expect_in("--set fbar", msg, "key 'fbar': expected true, false, anchored, paper, total or stable (got 'stabel')");
   const char *ok[] = {"fbar=stable", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-fbar-stable", 2, ok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
   if (e != 0) fail_msg("--set fbar=stable: expected success, got %d: %s", e, msg);
   const char *srt[] = {"sort_interval=-1"};
   e = run_lib(scene, DIR "/out-override", 1, srt, 0, msg, sizeof msg);
   if (e == 0) fail_msg("--set sort_interval=-1: expected a failure, got 0");
-  expect_in("--set sort_interval", msg, "key 'sort_interval': must be in [0, 1e+09] (got -1)");
+  test_expect_in("--set sort_interval", msg, "key 'sort_interval': must be in [0, 1e+09] (got -1)");
   /* an empty list of snapshot plots is none, not an error; sorting every step runs */
   const char *none[] = {"snapshot_plots=[]", "sort_interval=1", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-noplots", 3, none, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
@@ -182,27 +160,27 @@ static void test_existing_output(void **state) {
   fclose(f);
   int e = run_lib(scene, out, 0, NULL, 0, msg, sizeof msg);
   if (e == 0) fail_msg("a non-empty output directory without --force: expected a failure, got 0");
-  expect_in("existing output", msg, "exists and is not empty");
-  expect_in("existing output", msg, "--force");
-  if (exists(DIR "/out-existing/summary.json")) fail_msg("summary.json written without --force");
+  test_expect_in("existing output", msg, "exists and is not empty");
+  test_expect_in("existing output", msg, "--force");
+  if (test_exists(DIR "/out-existing/summary.json")) fail_msg("summary.json written without --force");
   char args[600];
   snprintf(args, sizeof args, "run '%s' --out '%s'", scene, out);
-  if (run_cli(args, msg, sizeof msg) == 0) fail_msg("mpmc run into a non-empty directory: exit status 0");
+  if (test_run_cli(args, msg, sizeof msg) == 0) fail_msg("mpmc run into a non-empty directory: exit status 0");
   /* with --force the run goes ahead */
   e = run_lib(scene, out, 0, NULL, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
   if (e) fail_msg("with --force: expected success, got %d: %s", e, msg);
-  if (!exists(DIR "/out-existing/summary.json")) fail_msg("with --force: no summary.json");
+  if (!test_exists(DIR "/out-existing/summary.json")) fail_msg("with --force: no summary.json");
 }
 
 static void test_usage(void **state) {
   (void)state;
   char msg[4096];
-  if (run_cli("--help", msg, sizeof msg) != 0) fail_msg("mpmc --help: expected exit status 0");
-  if (run_cli("frobnicate x.yaml", msg, sizeof msg) == 0) fail_msg("mpmc frobnicate: expected a failure");
-  expect_in("unknown command", msg, "unknown command 'frobnicate'");
-  if (run_cli("run " DIR "/does-not-exist.yaml", msg, sizeof msg) == 0)
+  if (test_run_cli("--help", msg, sizeof msg) != 0) fail_msg("mpmc --help: expected exit status 0");
+  if (test_run_cli("frobnicate x.yaml", msg, sizeof msg) == 0) fail_msg("mpmc frobnicate: expected a failure");
+  test_expect_in("unknown command", msg, "unknown command 'frobnicate'");
+  if (test_run_cli("run " DIR "/does-not-exist.yaml", msg, sizeof msg) == 0)
     fail_msg("mpmc run on a missing file: expected a failure");
-  expect_in("missing scene", msg, "does-not-exist.yaml: cannot open the scene file");
+  test_expect_in("missing scene", msg, "does-not-exist.yaml: cannot open the scene file");
 }
 
 int main(void) {

@@ -16,7 +16,6 @@
 #include <stddef.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include <cmocka.h>
 
@@ -41,26 +40,6 @@ static const char *scene_text =
     "  tip_displacement_y: {point: [0.5, 1.0]}\n"
     "  center_of_mass_x:\n";
 
-static int exists(const char *p) {
-  struct stat s;
-  return stat(p, &s) == 0;
-}
-
-/* A number after "key": in summary.json. */
-static double json_number(const char *path, const char *key) {
-  FILE *f = fopen(path, "r");
-  if (!f) fail_msg("cannot read %s", path);
-  static char buf[1 << 16];
-  const size_t n = fread(buf, 1, sizeof buf - 1, f);
-  fclose(f);
-  buf[n] = '\0';
-  char pat[128];
-  snprintf(pat, sizeof pat, "\"%s\": ", key);
-  const char *p = strstr(buf, pat);
-  if (!p) fail_msg("%s: expected a key \"%s\", found none", path, key);
-  return strtod(p + strlen(pat), NULL);
-}
-
 static void write_text(const char *path, const char *text) {
   mkdir(DIR, 0777);
   FILE *f = fopen(path, "w");
@@ -71,25 +50,14 @@ static void write_text(const char *path, const char *text) {
 
 static void write_scene(const char *path) { write_text(path, scene_text); }
 
-/* The whole of a file, NUL-terminated (static storage: one at a time). */
-static const char *slurp(const char *path) {
-  static char buf[1 << 16];
-  FILE *f = fopen(path, "r");
-  if (!f) fail_msg("cannot read %s", path);
-  const size_t n = fread(buf, 1, sizeof buf - 1, f);
-  fclose(f);
-  buf[n] = '\0';
-  return buf;
-}
-
 /* The summary in out after n steps of free fall from rest at dt = 0.001 s (every stage of
  * the scene): n steps, and the tip's u_y = -g dt^2 n (n + 1) / 2 (symplectic Euler) */
 static void expect_free_fall(const char *summary, int n, const char *what) {
   const double g = 9.81, dt = 0.001;
-  const double steps = json_number(summary, "steps");
+  const double steps = test_json_number(summary, "steps");
   if (steps != n) fail_msg("%s: expected %d steps in all, got %g", what, n, steps);
   const double expect = -g * dt * dt * n * (n + 1) / 2.0;
-  const double uy = json_number(summary, "tip_displacement_y");
+  const double uy = test_json_number(summary, "tip_displacement_y");
   if (fabs(uy - expect) > 1e-9 * fabs(expect))
     fail_msg("%s: tip_displacement_y expected %.12g, got %.12g", what, expect, uy);
 }
@@ -105,9 +73,9 @@ static void test_free_fall(void **state) {
   test_ctx = NULL;
   mpmc_context_destroy(&ctx);
   expect_free_fall(DIR "/out-fall/summary.json", 100, "free fall (2 stages of 0.05 s)");
-  const double cx = json_number(DIR "/out-fall/summary.json", "center_of_mass_x");
+  const double cx = test_json_number(DIR "/out-fall/summary.json", "center_of_mass_x");
   if (fabs(cx - 0.5) > 1e-12) fail_msg("free fall: center_of_mass_x expected 0.5, got %.15g", cx);
-  if (!exists(DIR "/out-fall/series.csv")) fail_msg("no series.csv");
+  if (!test_exists(DIR "/out-fall/series.csv")) fail_msg("no series.csv");
   /* a box scene never maps libgmsh */
   FILE *maps = fopen("/proc/self/maps", "r");
   if (maps) {
@@ -118,24 +86,11 @@ static void test_free_fall(void **state) {
   }
 }
 
-/* `mpmc args`: its exit status, and the start of what it printed (stdout and stderr) in msg;
- * the rest is read and dropped, so the program never waits on a full pipe */
-static int cli_output(const char *args, char *msg, size_t len) {
-  char cmd[2048], rest[4096];
-  snprintf(cmd, sizeof cmd, "'%s' %s 2>&1", MPMC_CLI, args);
-  FILE *pipe = popen(cmd, "r");
-  assert_non_null(pipe);
-  const size_t n = fread(msg, 1, len - 1, pipe);
-  msg[n] = '\0';
-  while (fread(rest, 1, sizeof rest, pipe) > 0) {
-  }
-  const int st = pclose(pipe);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static int run_cli(const char *args) {
-  char msg[4096];
-  return cli_output(args, msg, sizeof msg);
+/* The file at path still holds before; what names the case. */
+static void expect_unchanged(const char *path, const char *before, const char *what) {
+  char *now = test_slurp(path);
+  if (strcmp(before, now) != 0) fail_msg("%s: expected %s unchanged, it was rewritten:\n%s", what, path, now);
+  free(now);
 }
 
 static void test_check_and_resume(void **state) {
@@ -143,23 +98,21 @@ static void test_check_and_resume(void **state) {
   const char *scene = DIR "/fall.yaml";
   write_scene(scene);
   assert_int_equal(system("rm -rf '" DIR "/out-check' '" DIR "/out-resume'"), 0);
-  if (run_cli("check '" DIR "/fall.yaml' --out '" DIR "/out-check'") != 0) fail_msg("mpmc check: expected exit 0");
-  if (exists(DIR "/out-check")) fail_msg("mpmc check created its output directory");
-  if (run_cli("run '" DIR "/fall.yaml' --out '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc run: expected exit 0");
-  if (!exists(DIR "/out-resume/checkpoint.h5")) {
+  if (test_run_cli("check '" DIR "/fall.yaml' --out '" DIR "/out-check'", NULL, 0) != 0) fail_msg("mpmc check: expected exit 0");
+  if (test_exists(DIR "/out-check")) fail_msg("mpmc check created its output directory");
+  if (test_run_cli("run '" DIR "/fall.yaml' --out '" DIR "/out-resume' --quiet", NULL, 0) != 0) fail_msg("mpmc run: expected exit 0");
+  if (!test_exists(DIR "/out-resume/checkpoint.h5")) {
     /* a build without checkpoints says so */
-    if (run_cli("resume '" DIR "/out-resume'") == 0) fail_msg("resume without a checkpoint: expected a failure");
+    if (test_run_cli("resume '" DIR "/out-resume'", NULL, 0) == 0) fail_msg("resume without a checkpoint: expected a failure");
     return;
   }
   /* the checkpoint is the finished run: nothing to resume, and the outputs stay as they are */
-  char before[1 << 16];
-  snprintf(before, sizeof before, "%s", slurp(DIR "/out-resume/summary.json"));
-  if (run_cli("resume '" DIR "/out-resume' --quiet") == 0) fail_msg("resume of a finished run: expected a failure");
-  if (strcmp(before, slurp(DIR "/out-resume/summary.json")) != 0)
-    fail_msg("resume of a finished run rewrote summary.json");
+  char *before = test_slurp(DIR "/out-resume/summary.json");
+  if (test_run_cli("resume '" DIR "/out-resume' --quiet", NULL, 0) == 0) fail_msg("resume of a finished run: expected a failure");
+  expect_unchanged(DIR "/out-resume/summary.json", before, "resume of a finished run");
   /* the message says what to do */
   char msg[2048];
-  if (cli_output("resume '" DIR "/out-resume'", msg, sizeof msg) == 0)
+  if (test_run_cli("resume '" DIR "/out-resume'", msg, sizeof msg) == 0)
     fail_msg("resume of a finished run: expected a failure");
   if (!strstr(msg, "finished all 2 stages") || !strstr(msg, "add a stage"))
     fail_msg("resume of a finished run: expected 'finished all 2 stages ... add a stage', got: %s", msg);
@@ -171,30 +124,33 @@ static void test_check_and_resume(void **state) {
   const char *metrics = strstr(scene_text, "metrics:");
   snprintf(at, sizeof three - (size_t)(at - three), "  - {name: third, dt: 0.001, end: {time: 0.05}}\n%s", metrics);
   write_text(scene, three);
-  if (run_cli("resume '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc resume with a third stage: expected exit 0");
+  if (test_run_cli("resume '" DIR "/out-resume' --quiet", NULL, 0) != 0) fail_msg("mpmc resume with a third stage: expected exit 0");
   expect_free_fall(DIR "/out-resume/summary.json", 150, "resume with a third stage");
-  if (!strstr(slurp(DIR "/out-resume/summary.json"), "\"third\""))
-    fail_msg("resume: summary.json names no stage 'third'");
+  char *summary = test_slurp(DIR "/out-resume/summary.json");
+  if (!strstr(summary, "\"third\"")) fail_msg("resume: summary.json names no stage 'third'");
+  free(summary);
   /* the last stage's end raised from 0.05 to 0.08 s: it goes on from where it ended */
   char *end = strstr(three, "{name: third, dt: 0.001, end: {time: 0.05}}");
   assert_non_null(end);
   memcpy(strstr(end, "0.05"), "0.08", 4);
   write_text(scene, three);
-  if (run_cli("resume '" DIR "/out-resume' --quiet") != 0) fail_msg("mpmc resume with a later end: expected exit 0");
+  if (test_run_cli("resume '" DIR "/out-resume' --quiet", NULL, 0) != 0) fail_msg("mpmc resume with a later end: expected exit 0");
   expect_free_fall(DIR "/out-resume/summary.json", 180, "resume to a later end");
   /* a later end from the command line, after the run's own overrides: 20 steps more */
-  if (run_cli("resume '" DIR "/out-resume' --set stages.third.end.time=0.1 --quiet") != 0)
+  if (test_run_cli("resume '" DIR "/out-resume' --set stages.third.end.time=0.1 --quiet", NULL, 0) != 0)
     fail_msg("mpmc resume --set stages.third.end.time=0.1: expected exit 0");
   expect_free_fall(DIR "/out-resume/summary.json", 200, "resume --set to a later end");
   /* a bad override is named, and the outputs stay; --out does not apply to resume */
-  snprintf(before, sizeof before, "%s", slurp(DIR "/out-resume/summary.json"));
-  if (cli_output("resume '" DIR "/out-resume' --set stages.third.end.tme=1", msg, sizeof msg) == 0)
+  free(before);
+  before = test_slurp(DIR "/out-resume/summary.json");
+  if (test_run_cli("resume '" DIR "/out-resume' --set stages.third.end.tme=1", msg, sizeof msg) == 0)
     fail_msg("resume with a misspelt override: expected a failure");
   if (!strstr(msg, "tme")) fail_msg("resume with a misspelt override: the message does not name it: %s", msg);
-  if (strcmp(before, slurp(DIR "/out-resume/summary.json")) != 0) fail_msg("a refused resume rewrote summary.json");
-  if (run_cli("resume '" DIR "/out-resume' --out '" DIR "/elsewhere'") != 2) fail_msg("resume --out: expected exit 2");
+  expect_unchanged(DIR "/out-resume/summary.json", before, "a refused resume");
+  free(before);
+  if (test_run_cli("resume '" DIR "/out-resume' --out '" DIR "/elsewhere'", NULL, 0) != 2) fail_msg("resume --out: expected exit 2");
   /* and once more with nothing changed: finished, after three stages */
-  if (cli_output("resume '" DIR "/out-resume'", msg, sizeof msg) == 0) fail_msg("resume of the finished run: expected a failure");
+  if (test_run_cli("resume '" DIR "/out-resume'", msg, sizeof msg) == 0) fail_msg("resume of the finished run: expected a failure");
   if (!strstr(msg, "finished all 3 stages") || !strstr(msg, "raise the last stage's end time"))
     fail_msg("resume of a finished run: expected 'finished all 3 stages ... raise the last stage's end time', got: %s", msg);
 }
@@ -211,7 +167,7 @@ static void test_slope_locks_without_fbar(void **state) {
   mpmc_context_destroy(&ctx);
   /* volumetric locking (paper Fig. 16): the standard formulation barely moves, while with
    * F-bar the same slope runs out by metres (scene-slope_2d) */
-  const double r = json_number(DIR "/out-slope-std/summary.json", "runout_distance");
+  const double r = test_json_number(DIR "/out-slope-std/summary.json", "runout_distance");
   if (!(r < 1.0)) fail_msg("slope_2d without F-bar: expected a locked slope, run-out < 1 m, got %g m", r);
 }
 
@@ -233,8 +189,8 @@ static void test_node_set_wall(void **state) {
   (void)state;
   assert_int_equal(run_cook("stages.0.walls.0={set: clamp, kind: fixed}", DIR "/out-cook-set"), 0);
   assert_int_equal(run_cook("stages.0.walls.0={lo: [0, 0], hi: [0, 44], kind: fixed}", DIR "/out-cook-box"), 0);
-  const double a = json_number(DIR "/out-cook-set/summary.json", "tip_displacement_y");
-  const double b = json_number(DIR "/out-cook-box/summary.json", "tip_displacement_y");
+  const double a = test_json_number(DIR "/out-cook-set/summary.json", "tip_displacement_y");
+  const double b = test_json_number(DIR "/out-cook-box/summary.json", "tip_displacement_y");
   if (!(a > 1e-3) || a != b) fail_msg("tip u_y: node-set wall %.17g, box wall %.17g (expected equal, > 1 mm)", a, b);
   if (run_cook("stages.0.walls.0={set: nosuch, kind: fixed}", DIR "/out-cook-bad") == 0)
     fail_msg("a wall on an unknown node set: expected a failure");

@@ -65,21 +65,6 @@ static int run(const char *scene, const char *out, char *msg, size_t len) {
   return e;
 }
 
-/* A number after "key": in summary.json. */
-static double json_number(const char *path, const char *key) {
-  FILE *f = fopen(path, "r");
-  if (!f) fail_msg("cannot read %s", path);
-  static char buf[1 << 16];
-  const size_t n = fread(buf, 1, sizeof buf - 1, f);
-  fclose(f);
-  buf[n] = '\0';
-  char pat[128];
-  snprintf(pat, sizeof pat, "\"%s\": ", key);
-  const char *p = strstr(buf, pat);
-  if (!p) fail_msg("%s: expected a key \"%s\", found none", path, key);
-  return strtod(p + strlen(pat), NULL);
-}
-
 static void test_plate_on_block(void **state) {
   (void)state;
   char msg[1024];
@@ -88,19 +73,19 @@ static void test_plate_on_block(void **state) {
   if (e) fail_msg("expected the plate scene to run, got %d: %s", e, msg);
   const char *sum = DIR "/out/summary.json";
   const double V = 0.01, T = 1.0, tr = 0.2, dt = 0.002;
-  const double delta = json_number(sum, "settlement_over_B"); /* B = 1 m */
+  const double delta = test_json_number(sum, "settlement_over_B"); /* B = 1 m */
   const double want = V * (T - 0.5 * tr);
   if (!(fabs(delta - want) <= 0.5 * V * dt + 1e-12))
     fail_msg("plate settlement %.9g m, expected V (T - t_r/2) = %.9g m within V dt / 2", delta, want);
   /* uniaxial strain of the block: a point in the middle (initially at y = 0.5625) */
   const double E = 1.0e6, nu = 0.3, M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu)), y0 = 0.5625;
-  const double uy = json_number(sum, "tip_displacement_y");
-  const double q = json_number(sum, "q_over_su") * 1000.0; /* su = 1000 Pa, loaded width 1 m */
+  const double uy = test_json_number(sum, "tip_displacement_y");
+  const double q = test_json_number(sum, "q_over_su") * 1000.0; /* su = 1000 Pa, loaded width 1 m */
   const double qwant = M * -uy / y0;
   if (!(uy < 0 && -uy < delta)) fail_msg("top point moved %g m, expected down by less than the plate's %g m", uy, delta);
   if (!(fabs(q - qwant) <= 0.03 * qwant))
     fail_msg("plate pressure %.6g Pa, expected M eps = %.6g Pa within 3 %% (eps = %.4g)", q, qwant, -uy / y0);
-  const double ratio = json_number(sum, "bearing_capacity_ratio") * 1000.0;
+  const double ratio = test_json_number(sum, "bearing_capacity_ratio") * 1000.0;
   if (!(ratio > 0.5 * q && ratio < q))
     fail_msg("bearing_capacity_ratio su = %.6g Pa, expected between half and all of the final %.6g Pa "
              "(the load rises with the settlement)", ratio, q);

@@ -12,7 +12,6 @@
 #include <stddef.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -63,21 +62,6 @@ static int run_lib(const char *scene, const char *out, char *msg, size_t len) {
   return e;
 }
 
-static int run_cli(const char *args, char *msg, size_t len) {
-  char cmd[2048];
-  snprintf(cmd, sizeof cmd, "'%s' %s 2>&1 >/dev/null", MPMC_CLI, args);
-  FILE *p = popen(cmd, "r");
-  assert_non_null(p);
-  const size_t n = fread(msg, 1, len - 1, p);
-  msg[n] = '\0';
-  const int st = pclose(p);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-static void expect_in(const char *what, const char *msg, const char *part) {
-  if (!strstr(msg, part)) fail_msg("%s: expected the message to contain \"%s\", got \"%s\"", what, part, msg);
-}
-
 /* The checkpoint in out reads back and holds simulated time t. */
 static void expect_checkpoint(const char *what, const char *out, double t) {
   char path[600];
@@ -102,7 +86,7 @@ static void expect_summary_failed(const char *what, const char *out) {
   const size_t n = fread(buf, 1, sizeof buf - 1, f);
   buf[n] = '\0';
   fclose(f);
-  expect_in(what, buf, "\"status\": \"failed\"");
+  test_expect_in(what, buf, "\"status\": \"failed\"");
 }
 
 static void test_dt_refused(void **state) {
@@ -112,22 +96,22 @@ static void test_dt_refused(void **state) {
   write_scene(scene, extra);
   const int e = run_lib(scene, out, msg, sizeof msg);
   if (e != MPMC_ERR_UNSTABLE) fail_msg("dt = 1.5 h/c: expected MPMC_ERR_UNSTABLE (%d), got %d: %s", MPMC_ERR_UNSTABLE, e, msg);
-  expect_in("refused", msg, "stage 'load'");
-  expect_in("refused", msg, "exceeds the stability limit");
+  test_expect_in("refused", msg, "stage 'load'");
+  test_expect_in("refused", msg, "exceeds the stability limit");
   /* the block settles for 0.02 s; its velocities are small against c: the limit printed is
    * h/(c + |v|max), within 1 % of h/c */
   const char *p = strstr(msg, "stability limit h/(c + |v|max) = ");
   if (!p) fail_msg("refused: no limit in \"%s\"", msg);
   const double printed = atof(p + strlen("stability limit h/(c + |v|max) = "));
   TCLOSE(printed, limit(), 0.01 * limit());
-  expect_in("refused", msg, "last good state: " DIR "/out-refused/checkpoint.h5 (t = 0.02 s)");
+  test_expect_in("refused", msg, "last good state: " DIR "/out-refused/checkpoint.h5 (t = 0.02 s)");
   expect_summary_failed("refused", out);
   expect_checkpoint("refused", out, 0.02);
   char args[1400];
   snprintf(args, sizeof args, "run '%s' --out '%s' --force --quiet", scene, out);
-  const int st = run_cli(args, msg, sizeof msg);
+  const int st = test_run_cli(args, msg, sizeof msg);
   if (st == 0) fail_msg("refused: expected a non-zero exit status from mpmc, got 0");
-  expect_in("refused (mpmc)", msg, "exceeds the stability limit");
+  test_expect_in("refused (mpmc)", msg, "exceeds the stability limit");
 }
 
 static void test_forced_blowup(void **state) {
@@ -137,17 +121,17 @@ static void test_forced_blowup(void **state) {
   write_scene(scene, extra);
   const int e = run_lib(scene, out, msg, sizeof msg);
   if (e != MPMC_ERR_UNSTABLE) fail_msg("forced dt = 1.1 h/c: expected the monitor's MPMC_ERR_UNSTABLE, got %d: %s", e, msg);
-  expect_in("forced", msg, "stage 'load'");
-  expect_in("forced", msg, "kinetic energy grows without input");
-  expect_in("forced", msg, "fastest point ");
-  expect_in("forced", msg, "last good state: " DIR "/out-forced/checkpoint.h5 (t = 0.02 s)");
-  expect_in("forced", msg, "the failing state is the last snapshot in " DIR "/out-forced/snapshots.h5");
+  test_expect_in("forced", msg, "stage 'load'");
+  test_expect_in("forced", msg, "kinetic energy grows without input");
+  test_expect_in("forced", msg, "fastest point ");
+  test_expect_in("forced", msg, "last good state: " DIR "/out-forced/checkpoint.h5 (t = 0.02 s)");
+  test_expect_in("forced", msg, "the failing state is the last snapshot in " DIR "/out-forced/snapshots.h5");
   expect_summary_failed("forced", out);
   expect_checkpoint("forced", out, 0.02);
   char args[1400];
   snprintf(args, sizeof args, "run '%s' --out '%s' --force --quiet", scene, out);
-  if (run_cli(args, msg, sizeof msg) == 0) fail_msg("forced: expected a non-zero exit status from mpmc, got 0");
-  expect_in("forced (mpmc)", msg, "kinetic energy grows without input");
+  if (test_run_cli(args, msg, sizeof msg) == 0) fail_msg("forced: expected a non-zero exit status from mpmc, got 0");
+  test_expect_in("forced (mpmc)", msg, "kinetic energy grows without input");
   /* the way out the message gives: a stable step in the scene, then resume from the last
    * good state; the run completes */
   write_scene(scene, "dt_factor: 0.3");
@@ -198,13 +182,13 @@ static void test_total_form_flow(void **state) {
       if (e) fail_msg("dam break with Algorithm 1: expected to complete, got %d: %s", e, msg);
     } else {
       if (e != MPMC_ERR_UNSTABLE) fail_msg("dam break, stable form: expected MPMC_ERR_UNSTABLE, got %d: %s", e, msg);
-      expect_in("flow", msg, "kinetic energy grows without input");
-      expect_in("flow", msg, "use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene 'fbar: true')");
-      expect_in("flow", msg, "the stable form projects the points' own J");
+      test_expect_in("flow", msg, "kinetic energy grows without input");
+      test_expect_in("flow", msg, "use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene 'fbar: true')");
+      test_expect_in("flow", msg, "the stable form projects the points' own J");
       /* the whole report survives: the way back and where the failing state went (a
          1024-byte buffer cut this message inside its last sentence) */
-      expect_in("flow", msg, "last good state: " DIR "/out-flow/checkpoint.h5 (t = 0 s)");
-      expect_in("flow", msg, "the failing state is the last snapshot in " DIR "/out-flow/snapshots.h5");
+      test_expect_in("flow", msg, "last good state: " DIR "/out-flow/checkpoint.h5 (t = 0 s)");
+      test_expect_in("flow", msg, "the failing state is the last snapshot in " DIR "/out-flow/snapshots.h5");
     }
   }
 }
@@ -218,7 +202,7 @@ static void test_out_not_creatable(void **state) {
   fclose(f);
   const int e = run_lib(scene, DIR "/afile/out", msg, sizeof msg);
   if (e != MPMC_ERR_IO) fail_msg("output under a file: expected MPMC_ERR_IO (%d), got %d: %s", MPMC_ERR_IO, e, msg);
-  expect_in("not creatable", msg, DIR "/afile/out");
+  test_expect_in("not creatable", msg, DIR "/afile/out");
 }
 
 /* series.csv on a full disk: the run stops with the file and the reason; the checkpoint of
@@ -233,7 +217,7 @@ static void test_series_disk_full(void **state) {
   if (symlink("/dev/full", DIR "/out-series/series.csv")) fail_msg("cannot create the symlink to /dev/full");
   const int e = run_lib(scene, out, msg, sizeof msg);
   if (e != MPMC_ERR_IO) fail_msg("series.csv on /dev/full: expected MPMC_ERR_IO, got %d: %s", e, msg);
-  expect_in("series full", msg, "cannot write " DIR "/out-series/series.csv: No space left on device");
+  test_expect_in("series full", msg, "cannot write " DIR "/out-series/series.csv: No space left on device");
   expect_checkpoint("series full", out, 0.0);
 }
 
@@ -267,8 +251,8 @@ static void test_checkpoint_disk_full(void **state) {
   close(fd[0]);
   waitpid(pid, NULL, 0);
   if (e != MPMC_ERR_IO) fail_msg("checkpoint on /dev/full: expected MPMC_ERR_IO, got %d: %s", e, msg);
-  expect_in("checkpoint full", msg, "checkpoint " DIR "/out-ckpt/checkpoint.h5");
-  expect_in("checkpoint full", msg, "checkpoint.h5.tmp");
+  test_expect_in("checkpoint full", msg, "checkpoint " DIR "/out-ckpt/checkpoint.h5");
+  test_expect_in("checkpoint full", msg, "checkpoint.h5.tmp");
   expect_checkpoint("checkpoint full", out, 1.02);
   struct stat st;
   if (lstat(DIR "/out-ckpt/checkpoint.h5.tmp", &st) == 0) fail_msg("the temporary checkpoint was left behind");

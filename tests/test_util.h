@@ -1,10 +1,14 @@
-/* Helpers shared by the C tests: lattice seeding of boxes and small checks. */
+/* Helpers shared by the C tests: lattice seeding of boxes, small checks, files and the
+ * `mpmc` program.  Include <cmocka.h> first (fail_msg). */
 #ifndef MPMC_TEST_UTIL_H
 #define MPMC_TEST_UTIL_H
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 
 #include "mpmc.h"
 
@@ -73,5 +77,67 @@ static inline int test_lattice(int dim, const double *lo, const double *hi, doub
       }
   return n;
 }
+
+/* ---- files ------------------------------------------------------------------------- */
+
+/* Whether path exists (file or directory). */
+static inline int test_exists(const char *path) {
+  struct stat s;
+  return stat(path, &s) == 0;
+}
+
+/* The whole of a file, NUL-terminated, malloc'ed (free it); fails the test if unreadable. */
+static inline char *test_slurp(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) fail_msg("expected to read %s, cannot open it", path);
+  size_t cap = 1 << 12, n = 0, got;
+  char *s = malloc(cap);
+  while ((got = fread(s + n, 1, cap - 1 - n, f)) > 0) {
+    n += got;
+    if (n == cap - 1) s = realloc(s, cap *= 2);
+  }
+  fclose(f);
+  s[n] = '\0';
+  return s;
+}
+
+/* The number after "key": in a JSON file (summary.json); fails the test without the key. */
+static inline double test_json_number(const char *path, const char *key) {
+  char *text = test_slurp(path), pat[128];
+  snprintf(pat, sizeof pat, "\"%s\": ", key);
+  const char *p = strstr(text, pat);
+  if (!p) fail_msg("%s: expected a key \"%s\", found none", path, key);
+  const double v = strtod(p + strlen(pat), NULL);
+  free(text);
+  return v;
+}
+
+/* Fail unless msg contains part; what names the case. */
+static inline void test_expect_in(const char *what, const char *msg, const char *part) {
+  if (!strstr(msg, part))
+    fail_msg("%s: expected the message to contain \"%s\", got \"%s\"", what, part, msg);
+}
+
+#ifdef MPMC_CLI
+/* Run the `mpmc` program (MPMC_CLI, set by tests/workflows.cmake and tests/robust.cmake) with
+ * the arguments args (a shell command line); returns its exit status (-1 if it did not exit).
+ * The start of its stderr is copied into msg (len bytes, NUL-terminated) unless msg is NULL;
+ * stdout is dropped, and the rest of stderr is read, so the program never waits on a full
+ * pipe. */
+static inline int test_run_cli(const char *args, char *msg, size_t len) {
+  char cmd[4096], rest[4096];
+  snprintf(cmd, sizeof cmd, "'%s' %s 2>&1 >/dev/null", MPMC_CLI, args);
+  FILE *p = popen(cmd, "r");
+  if (!p) fail_msg("expected to start %s", cmd);
+  if (msg && len > 0) {
+    const size_t n = fread(msg, 1, len - 1, p);
+    msg[n] = '\0';
+  }
+  while (fread(rest, 1, sizeof rest, p) > 0) {
+  }
+  const int st = pclose(p);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+#endif
 
 #endif
