@@ -63,6 +63,8 @@ module mpmc
   ! mpmc_workflow_run flags
   integer(c_int), parameter, public :: MPMC_WORKFLOW_FORCE = 1, MPMC_WORKFLOW_QUIET = 2, &
     MPMC_WORKFLOW_CHECK = 4
+  !> The run monitor's default energy factor (mpmc_sim_set_energy_monitor).
+  real(c_double), parameter, public :: MPMC_MONITOR_ENERGY_FACTOR = 10.0_c_double
   !> The paper's strength reduction factor (landslide trigger), for mpmc_sim_reduce_strength.
   real(c_double), parameter, public :: MPMC_DEFAULT_STRENGTH_REDUCTION = 1.65_c_double
 
@@ -124,7 +126,8 @@ module mpmc
   public :: mpmc_sim_add_wall, mpmc_sim_add_wall_face, mpmc_sim_add_wall_box, &
     mpmc_sim_add_wall_nodes, mpmc_sim_remove_wall
   public :: mpmc_sim_stable_dt, mpmc_sim_step, mpmc_sim_set_force_dt, mpmc_sim_get_time, &
-    mpmc_sim_set_time, mpmc_sim_get_kinetic_energy, mpmc_sim_get_stats
+    mpmc_sim_set_time, mpmc_sim_get_kinetic_energy, mpmc_sim_get_stats, &
+    mpmc_sim_set_energy_monitor
   public :: mpmc_sim_get_num_particle_sets, mpmc_sim_get_num_node_sets, mpmc_sim_seed_box, &
     mpmc_sim_seed_polygon, mpmc_seed_gmsh
   public :: mpmc_output_write, mpmc_output_destroy, mpmc_free
@@ -564,6 +567,19 @@ module mpmc
       integer(c_int) :: ierr
     end function
 
+    ! ---- run monitor ------------------------------------------------------------------------
+    !> Stop a step with MPMC_ERR_UNSTABLE when the kinetic energy exceeds factor times the
+    !> energy available since the last change of inputs: factor > 1 (default
+    !> MPMC_MONITOR_ENERGY_FACTOR), 0 restores the default, < 0 turns the check off.  Every
+    !> call starts a new baseline.
+    function mpmc_sim_set_energy_monitor(sim, factor) bind(C, name='mpmc_sim_set_energy_monitor') &
+        result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), value :: factor
+      integer(c_int) :: ierr
+    end function
+
     ! ---- rigid bodies and contact -------------------------------------------------------
     function mpmc_sim_add_rigid_box(sim, lo, hi, mu, id) bind(C, name='mpmc_sim_add_rigid_box') &
         result(ierr)
@@ -805,6 +821,14 @@ module mpmc
       character(kind=c_char), intent(in) :: scene(*), outdir(*)
       integer(c_int), value :: noverride
       type(c_ptr), intent(in) :: overrides(*)
+      integer(c_int), value :: flags
+      integer(c_int) :: ierr
+    end function
+    function mpmc_workflow_resume_c(ctx, outdir, flags) bind(C, name='mpmc_workflow_resume') &
+        result(ierr)
+      import :: c_int, c_char, mpmc_context
+      type(mpmc_context), value :: ctx
+      character(kind=c_char), intent(in) :: outdir(*)
       integer(c_int), value :: flags
       integer(c_int) :: ierr
     end function
@@ -1245,7 +1269,8 @@ contains
   !> Continue the run in outdir from its last checkpoint (`mpmc resume`), a finished run once
   !> its scene asks for more; overrides ("key.path=value") apply after the run's own, e.g.
   !> 'stages.runout.end.time=8'; flags: MPMC_WORKFLOW_QUIET.  MPMC_ERR_UNSUPPORTED without
-  !> the workflow library.
+  !> the workflow library.  Calls mpmc_workflow_resume without overrides and
+  !> mpmc_workflow_resume_set with them.
   function mpmc_workflow_resume(ctx, outdir, flags, overrides) result(ierr)
     type(mpmc_context), intent(in) :: ctx
     character(*), intent(in) :: outdir
@@ -1259,6 +1284,10 @@ contains
     integer(c_int) :: f
     f = 0
     if (present(flags)) f = flags
+    if (.not. present(overrides)) then
+      ierr = mpmc_workflow_resume_c(ctx, mpmc_c_str(outdir), f)
+      return
+    end if
     call c_strings(overrides, buf, ptrs, n)
     ierr = mpmc_workflow_resume_set_c(ctx, mpmc_c_str(outdir), int(n, c_int), ptrs, f)
 #else

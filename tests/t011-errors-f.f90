@@ -1,5 +1,6 @@
 ! Fortran twin of the error tests: a failing call returns its code and the context's message
-! reads as an ordinary Fortran string; error strings match the C X-macro list.
+! reads as an ordinary Fortran string; error strings match the C X-macro list; the energy
+! monitor's factor reaches C by value (a bad one is named in the message).
 program t011_errors_f
   use, intrinsic :: iso_c_binding, only: c_int, c_double
   use mpmc
@@ -68,6 +69,20 @@ program t011_errors_f
   call expect_str('mpmc_kernels_name(MPMC_KERNELS_BASELINE)', 'baseline', &
     mpmc_kernels_name(MPMC_KERNELS_BASELINE))
   call expect_str('mpmc_kernels_name(7)', 'unknown kernel set', mpmc_kernels_name(7_c_int))
+  ! the run monitor's energy factor goes by value: 0.5 is refused and named, factors above 1,
+  ! the default (0) and off (< 0) are taken
+  ierr = mpmc_sim_set_energy_monitor(sim, 0.5_c_double)
+  call expect_int('mpmc_sim_set_energy_monitor(0.5)', MPMC_ERR_ARG, ierr)
+  call expect_has('message of set_energy_monitor(0.5)', mpmc_context_last_error(ctx), &
+    'energy monitor factor = 0.5 must be > 1')
+  call check(mpmc_sim_set_energy_monitor(sim, 2.0_c_double) == MPMC_SUCCESS, &
+    'set_energy_monitor(2)')
+  call check(mpmc_sim_set_energy_monitor(sim, MPMC_MONITOR_ENERGY_FACTOR) == MPMC_SUCCESS, &
+    'set_energy_monitor(MPMC_MONITOR_ENERGY_FACTOR)')
+  call check(mpmc_sim_set_energy_monitor(sim, 0.0_c_double) == MPMC_SUCCESS, &
+    'set_energy_monitor(0): the default')
+  call check(mpmc_sim_set_energy_monitor(sim, -1.0_c_double) == MPMC_SUCCESS, &
+    'set_energy_monitor(-1): off')
   ! clearing forgets the message
   call check(mpmc_context_clear_error(ctx) == MPMC_SUCCESS, 'mpmc_context_clear_error')
   call expect_str('message after clear', '', mpmc_context_last_error(ctx))
