@@ -12,8 +12,9 @@
  *   checkpoint at that stage's start, again to the same bits and the same series.csv (no
  *   row of zero energy at the stage's start).
  * - `mpmc run --force` into a directory of an earlier run removes that run's files (the
- *   resumed snapshots, snapshot-plot data, a stale checkpoint) and nothing else: a file of
- *   the user's, one with a near name and a subdirectory stay. */
+ *   resumed snapshots, snapshot-plot data, a stale temporary checkpoint) and nothing else: a
+ *   file of the user's, one with a near name and a subdirectory stay; checkpoint.h5 is
+ *   replaced by the run's own. */
 #include <setjmp.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -282,6 +283,7 @@ static void test_force(void **state) {
                                     "snapshots_gone_speed.png", "final_eps_p.png", "bearing.png"};
   static const char *const mine[] = {"notes.txt", "series.csv.bak", "snap.csv", "mine/summary.json"};
   char path[512];
+  write_text(DIR "/force/checkpoint.h5", "not a checkpoint\n");
   for (size_t i = 0; i < sizeof old / sizeof old[0]; ++i) {
     snprintf(path, sizeof path, "%s/force/%s", DIR, old[i]);
     write_text(path, "from an earlier run\n");
@@ -300,6 +302,15 @@ static void test_force(void **state) {
     snprintf(path, sizeof path, "%s/force/%s", DIR, mine[i]);
     if (!exists(path)) fail_msg("mpmc run --force removed %s, a file the run does not write", path);
   }
+  /* the earlier checkpoint.h5 (here not even a checkpoint) is replaced by the run's own */
+  mpmc_context ctx;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  mpmc_sim sim = NULL;
+  TCALL(mpmc_sim_checkpoint_read(ctx, DIR "/force/checkpoint.h5", &sim, NULL));
+  mpmc_sim_destroy(&sim);
+  test_ctx = NULL;
+  mpmc_context_destroy(&ctx);
   char *sum = slurp(DIR "/force/summary.json");
   if (!strstr(sum, "\"completed\"")) fail_msg("summary.json of the forced run: %s", sum);
   free(sum);

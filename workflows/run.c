@@ -161,7 +161,7 @@ static int named(const char *name, const char *pre, const char *suf) {
 /* Is `name` a file a run writes into its output directory (docs/workflows.md, "Outputs")? */
 static int run_output(const char *name) {
   static const char *const files[] = {"summary.json", "series.csv", "snapshots.h5", "snapshots.xdmf",
-                                      "snapshots_resumed.h5", "snapshots_resumed.xdmf", "checkpoint.h5",
+                                      "snapshots_resumed.h5", "snapshots_resumed.xdmf", "checkpoint.h5.tmp",
                                       "final_state.csv", "final_mean_stress.png", "final_eps_p.png", "series.png",
                                       "bearing.png", "plots.log", "snapshot_plots.log", NULL};
   for (int i = 0; files[i]; ++i) {
@@ -177,7 +177,9 @@ static int run_output(const char *name) {
 
 /* --force: remove the files an earlier run left in the output directory, so that none of them
  * passes for this run's; only those names (never the directory, nor a file the run does not
- * write). */
+ * write).  checkpoint.h5 is not removed but replaced, atomically, by the checkpoint the run
+ * writes before its first step: a run that cannot write it stops there and the earlier
+ * run's last good state is not lost (t690). */
 static int remove_old_outputs(wf_run *w) {
   DIR *d = opendir(w->out);
   if (!d) return fail(w, MPMC_ERR_IO, "cannot read '%s': %s", w->out, strerror(errno));
@@ -660,7 +662,8 @@ static void write_summary(wf_run *w, int ok, int nstages_done) {
   fprintf(f, "  \"dim\": %d,\n  \"basis\": \"%s\",\n  \"fbar\": %s,\n  \"cell_size\": %.9g,\n", w->sc.dim,
           wf_basis_name(w->sc.basis), w->sc.fbar == MPMC_FBAR_TOTAL    ? "\"total\""
           : w->sc.fbar == MPMC_FBAR_STABLE ? "\"stable\""
-          : w->sc.fbar                     ? "true"
+          : w->sc.fbar == MPMC_FBAR_PAPER  ? "\"paper\""
+          : w->sc.fbar                     ? "\"anchored\""
                                            : "false", w->sc.h);
   int kern = MPMC_KERNELS_BASELINE;
   mpmc_sim_get_kernels(w->sim, &kern);
