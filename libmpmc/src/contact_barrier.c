@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "contact.h"
+#include "geom.h"
 #include "mpmc_impl.h"
 
 /* the gap ratio x = d/dhat at which the default kappa makes the barrier's time-step limit
@@ -435,15 +436,6 @@ int mpmc_sim_add_rigid_box(mpmc_sim sim, const double *lo, const double *hi, dou
   return push_body(sim, &b, id);
 }
 
-/* Do segments p1-p2 and p3-p4 intersect (proper or touching)? */
-static int segments_cross(const double *p1, const double *p2, const double *p3, const double *p4) {
-  const double d1 = (p4[0] - p3[0]) * (p1[1] - p3[1]) - (p4[1] - p3[1]) * (p1[0] - p3[0]);
-  const double d2 = (p4[0] - p3[0]) * (p2[1] - p3[1]) - (p4[1] - p3[1]) * (p2[0] - p3[0]);
-  const double d3 = (p2[0] - p1[0]) * (p3[1] - p1[1]) - (p2[1] - p1[1]) * (p3[0] - p1[0]);
-  const double d4 = (p2[0] - p1[0]) * (p4[1] - p1[1]) - (p2[1] - p1[1]) * (p4[0] - p1[0]);
-  return ((d1 > 0) != (d2 > 0) || d1 == 0 || d2 == 0) && ((d3 > 0) != (d4 > 0) || d3 == 0 || d4 == 0);
-}
-
 /**
  * @brief Add a rigid simple polygon (2D only) of nvert vertices xy[2*nvert], either
  *        orientation; it stays still until mpmc_sim_set_rigid_velocity.
@@ -472,7 +464,8 @@ int mpmc_sim_add_rigid_polygon(mpmc_sim sim, int nvert, const double *xy, double
     for (int j = i + 2; j < nvert; ++j) {
       if (i == 0 && j == nvert - 1) continue; /* adjacent through the closing edge */
       const int i1 = (i + 1) % nvert, j1 = (j + 1) % nvert;
-      MPMC_CHECK(!segments_cross(xy + 2 * i, xy + 2 * i1, xy + 2 * j, xy + 2 * j1), ctx,
+      /* touching counts: a body's boundary must not meet itself */
+      MPMC_CHECK(!mpmc_segments_cross(xy + 2 * i, xy + 2 * i1, xy + 2 * j, xy + 2 * j1, 1), ctx,
                  MPMC_ERR_ARG, "polygon is not simple: edges %d-%d and %d-%d intersect", i, i1, j,
                  j1);
     }

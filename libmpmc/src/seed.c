@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "geom.h"
 #include "seed.h"
 
 int mpmc_lattice_init(mpmc_sim sim, const double *bblo, const double *bbhi, int ppc,
@@ -155,17 +156,6 @@ static int in_polygon(int nv, const double *xy, double px, double py, double tol
   return in;
 }
 
-static double cross3(const double *a, const double *b, const double *c) {
-  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-}
-
-/* Proper or touching intersection of segments ab and cd. */
-static int segments_cross(const double *a, const double *b, const double *c, const double *d) {
-  const double d1 = cross3(c, d, a), d2 = cross3(c, d, b), d3 = cross3(a, b, c),
-               d4 = cross3(a, b, d);
-  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
-}
-
 /**
  * @brief 2D: seed the simple polygon xy[2*nvert] (either orientation) with ppc x ppc
  *        lattice points per grid cell, kept where they fall inside (even-odd rule).
@@ -197,8 +187,9 @@ int mpmc_sim_seed_polygon(mpmc_sim sim, int nvert, const double *xy, int ppc, in
     for (int i = 0; i < nvert; ++i)
       for (int j = i + 2; j < nvert; ++j) {
         if (i == 0 && j == nvert - 1) continue; /* adjacent through the closing edge */
-        MPMC_CHECK(!segments_cross(xy + 2 * i, xy + 2 * ((i + 1) % nvert), xy + 2 * j,
-                                   xy + 2 * ((j + 1) % nvert)),
+        /* proper crossings only */
+        MPMC_CHECK(!mpmc_segments_cross(xy + 2 * i, xy + 2 * ((i + 1) % nvert), xy + 2 * j,
+                                        xy + 2 * ((j + 1) % nvert), 0),
                    ctx, MPMC_ERR_ARG, "seed polygon: edges %d and %d cross (not a simple polygon)",
                    i, j);
       }
