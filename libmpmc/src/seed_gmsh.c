@@ -64,6 +64,13 @@ static int has_suffix(const char *s, const char *suf) {
   return n >= m && strcmp(s + n - m, suf) == 0;
 }
 
+/* The private directory of a .geo's mesh (mesh_in_child) and the .msh in it, removed once
+ * the mesh is read or meshing failed; msh may not exist yet. */
+static void drop_mesh_dir(const char *dir, const char *msh) {
+  remove(msh);
+  rmdir(dir);
+}
+
 /* gmsh 4.8's .geo parser keeps a broken state for the rest of the process after a syntax
  * error (every later file fails with "line 0: syntax error", even after gmshFinalize and
  * gmshInitialize).  So a .geo is parsed and meshed in a forked child that writes a .msh
@@ -77,7 +84,7 @@ static int mesh_in_child(session *s, int dim, char *dir, size_t dirlen, char *ms
   snprintf(msh, mshlen, "%s/mesh.msh", dir);
   int pfd[2];
   if (pipe(pfd) != 0) {
-    rmdir(dir);
+    drop_mesh_dir(dir, msh);
     return MPMC_ERROR(s->ctx, MPMC_ERR_IO, "gmsh: cannot create a pipe: %s", strerror(errno));
   }
   fflush(NULL);
@@ -85,7 +92,7 @@ static int mesh_in_child(session *s, int dim, char *dir, size_t dirlen, char *ms
   if (pid < 0) {
     close(pfd[0]);
     close(pfd[1]);
-    rmdir(dir);
+    drop_mesh_dir(dir, msh);
     return MPMC_ERROR(s->ctx, MPMC_ERR_IO, "gmsh: cannot fork: %s", strerror(errno));
   }
   if (pid == 0) { /* the child: parse, check, mesh, write; report an error and exit */
@@ -165,8 +172,7 @@ static int mesh_in_child(session *s, int dim, char *dir, size_t dirlen, char *ms
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
   if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return MPMC_SUCCESS;
-  remove(msh);
-  rmdir(dir);
+  drop_mesh_dir(dir, msh);
   if (!WIFEXITED(status))
     return MPMC_ERROR(s->ctx, MPMC_ERR_FORMAT, "gmsh: meshing '%s' crashed (signal %d)", s->file,
                       WIFSIGNALED(status) ? WTERMSIG(status) : 0);
@@ -219,7 +225,7 @@ static int session_open(session *s, int dim) {
   if (geo) MPMC_CALL(mesh_in_child(s, dim, dir, sizeof dir, msh, sizeof msh));
   gmshInitialize(0, NULL, 0, &ierr);
   if (ierr) {
-    if (geo) remove(msh), rmdir(dir);
+    if (geo) drop_mesh_dir(dir, msh);
     return MPMC_ERROR(s->ctx, MPMC_ERR_UNSUPPORTED, "gmsh: cannot initialise the gmsh library");
   }
   s->up = 1;
@@ -229,7 +235,7 @@ static int session_open(session *s, int dim) {
   char msg[512];
   gmsh_last_error(msg, sizeof msg);
   const int err = ierr || msg[0] ? 0 : check_empty_groups(s, geo ? msh : s->file);
-  if (geo) remove(msh), rmdir(dir);
+  if (geo) drop_mesh_dir(dir, msh);
   if (ierr || msg[0])
     return MPMC_ERROR(s->ctx, MPMC_ERR_FORMAT, "gmsh: cannot read '%s': %s", s->file,
                       msg[0] ? msg : "unknown error");
@@ -291,6 +297,29 @@ static int push_simplex(mpmc_context ctx, simplices *S, const nodes *nd, const s
   return MPMC_SUCCESS;
 }
 
+/* The elements of one entity, by type, as gmsh hands them out: element tags etags[t] and
+ * node tags ntags[t] for type types[t]; released with elements_free. */
+typedef struct {
+  int *types;
+  size_t ntypes, **etags, *etags_n, etags_nn, **ntags, *ntags_n, ntags_nn;
+} elements;
+
+static void elements_get(elements *el, int dim, int tag, int *ierr) {
+  memset(el, 0, sizeof *el);
+  gmshModelMeshGetElements(&el->types, &el->ntypes, &el->etags, &el->etags_n, &el->etags_nn, &el->ntags,
+                           &el->ntags_n, &el->ntags_nn, dim, tag, ierr);
+}
+
+static void elements_free(elements *el) {
+  for (size_t t = 0; t < el->etags_nn; ++t) gmshFree(el->etags[t]);
+  for (size_t t = 0; t < el->ntags_nn; ++t) gmshFree(el->ntags[t]);
+  gmshFree(el->etags);
+  gmshFree(el->etags_n);
+  gmshFree(el->ntags);
+  gmshFree(el->ntags_n);
+  gmshFree(el->types);
+}
+
 /* Split the elements (by their primary, i.e. corner, nodes) of the entities in a physical
  * group into simplices of dimension gdim. */
 static int group_simplices(session *s, const nodes *nd, int gdim, int ptag, const char *gname,
@@ -303,18 +332,15 @@ static int group_simplices(session *s, const nodes *nd, int gdim, int ptag, cons
   if (ierr) return gmsh_error(s, MPMC_ERR_FORMAT, "cannot list the entities of a group in");
   int err = MPMC_SUCCESS;
   for (size_t e = 0; e < nent && !err; ++e) {
-    int *types = NULL;
-    size_t ntypes = 0, **etags = NULL, *etags_n = NULL, etags_nn = 0, **ntags = NULL,
-           *ntags_n = NULL, ntags_nn = 0;
-    gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &etags_nn, &ntags, &ntags_n,
-                             &ntags_nn, gdim, ents[e], &ierr);
+    elements els;
+    elements_get(&els, gdim, ents[e], &ierr);
     if (ierr) err = gmsh_error(s, MPMC_ERR_FORMAT, "cannot read the elements of");
-    for (size_t t = 0; t < ntypes && !err; ++t) {
+    for (size_t t = 0; t < els.ntypes && !err; ++t) {
       char *ename = NULL;
       int edim = 0, order = 0, nnode = 0, nprim = 0;
       double *lc = NULL;
       size_t nlc = 0;
-      gmshModelMeshGetElementProperties(types[t], &ename, &edim, &order, &nnode, &lc, &nlc, &nprim,
+      gmshModelMeshGetElementProperties(els.types[t], &ename, &edim, &order, &nnode, &lc, &nlc, &nprim,
                                         &ierr);
       /* corner-node splits into simplices (gmsh node order) */
       static const int pt[1][1] = {{0}}, seg[1][2] = {{0, 1}}, tri[1][3] = {{0, 1, 2}},
@@ -335,19 +361,13 @@ static int group_simplices(session *s, const nodes *nd, int gdim, int ptag, cons
         err = MPMC_ERROR(s->ctx, MPMC_ERR_UNSUPPORTED,
                          "gmsh: group '%s' in '%s' has elements of type '%s' (not supported)",
                          gname, s->file, ename ? ename : "?");
-      for (size_t el = 0; el < etags_n[t] && !err; ++el)
+      for (size_t el = 0; el < els.etags_n[t] && !err; ++el)
         for (int k = 0; k < nsplit && !err; ++k)
-          err = push_simplex(s->ctx, S, nd, ntags[t] + el * (size_t)nnode, split + k * S->nv);
+          err = push_simplex(s->ctx, S, nd, els.ntags[t] + el * (size_t)nnode, split + k * S->nv);
       gmshFree(ename);
       gmshFree(lc);
     }
-    for (size_t t = 0; t < etags_nn; ++t) gmshFree(etags[t]);
-    for (size_t t = 0; t < ntags_nn; ++t) gmshFree(ntags[t]);
-    gmshFree(etags);
-    gmshFree(etags_n);
-    gmshFree(ntags);
-    gmshFree(ntags_n);
-    gmshFree(types);
+    elements_free(&els);
   }
   gmshFree(ents);
   if (!err && S->n == 0)
@@ -483,19 +503,16 @@ static int seed_quadrature(session *s, mpmc_sim sim, int ptag, const char *regio
   char itype[32];
   gmshModelGetEntitiesForPhysicalGroup(d, ptag, &ents, &nent, &ierr);
   for (size_t e = 0; e < nent && !err; ++e) {
-    int *types = NULL;
-    size_t ntypes = 0, **etags = NULL, *etags_n = NULL, etags_nn = 0, **ntags = NULL,
-           *ntags_n = NULL, ntags_nn = 0;
-    gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &etags_nn, &ntags, &ntags_n,
-                             &ntags_nn, d, ents[e], &ierr);
-    for (size_t t = 0; t < ntypes && !err; ++t) {
+    elements els;
+    elements_get(&els, d, ents[e], &ierr);
+    for (size_t t = 0; t < els.ntypes && !err; ++t) {
       double *lc = NULL, *w = NULL, *jac = NULL, *det = NULL, *xq = NULL;
       size_t nlc = 0, nw = 0, njac = 0, ndet = 0, nxq = 0;
       /* the lowest Gauss rule of at least the requested order whose weights are all
        * positive (gmsh's order-3 triangle rule has a negative weight: no point volume) */
       for (int o = order; o <= order + 4; ++o) {
         snprintf(itype, sizeof itype, "Gauss%d", o);
-        gmshModelMeshGetIntegrationPoints(types[t], itype, &lc, &nlc, &w, &nw, &ierr);
+        gmshModelMeshGetIntegrationPoints(els.types[t], itype, &lc, &nlc, &w, &nw, &ierr);
         int positive = !ierr && nw > 0;
         for (size_t k = 0; k < nw && positive; ++k) positive = w[k] > 0;
         if (positive || ierr) break;
@@ -505,9 +522,9 @@ static int seed_quadrature(session *s, mpmc_sim sim, int ptag, const char *regio
         nw = 0;
       }
       if (!ierr)
-        gmshModelMeshGetJacobians(types[t], lc, nlc, &jac, &njac, &det, &ndet, &xq, &nxq, ents[e],
+        gmshModelMeshGetJacobians(els.types[t], lc, nlc, &jac, &njac, &det, &ndet, &xq, &nxq, ents[e],
                                   0, 1, &ierr);
-      if (ierr || nw == 0 || ndet != etags_n[t] * nw) {
+      if (ierr || nw == 0 || ndet != els.etags_n[t] * nw) {
         err = gmsh_error(s, MPMC_ERR_FORMAT, "cannot integrate the elements of");
       } else {
         if (n + ndet > cap) {
@@ -528,13 +545,7 @@ static int seed_quadrature(session *s, mpmc_sim sim, int ptag, const char *regio
       gmshFree(det);
       gmshFree(xq);
     }
-    for (size_t t = 0; t < etags_nn; ++t) gmshFree(etags[t]);
-    for (size_t t = 0; t < ntags_nn; ++t) gmshFree(ntags[t]);
-    gmshFree(etags);
-    gmshFree(etags_n);
-    gmshFree(ntags);
-    gmshFree(ntags_n);
-    gmshFree(types);
+    elements_free(&els);
   }
   gmshFree(ents);
   if (!err && n == 0)
