@@ -1,13 +1,17 @@
-/* Scene metrics and the progress display.
+/* Reporting: scene metrics, series.csv, summary.json and the progress display.  run.c calls
+ * these; nothing here calls back into run.c.
  *
  * Run-out distance (docs/workflows.md): the slope faces +axis (default x); the initial toe
  * x_toe is `metrics.runout_distance.toe` or, when not given, the largest initial coordinate
  * of any material point along that axis (a slope standing on the grid floor).  The run-out
  * distance is max(0, max_p x_p - x_toe): how far the farthest material has travelled beyond
  * the initial toe. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "wf.h"
@@ -138,7 +142,188 @@ int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *v) {
   return e;
 }
 
+/* ---- series.csv ----------------------------------------------------------------------------- */
+
+/**
+ * @brief Open series.csv at path: a new file (append = 0), or the one a resumed run goes on
+ *        with; the header is written to a new or empty file.  NULL with msg on failure.
+ */
+FILE *wf_series_open(const char *path, const wf_scene *sc, int append, char *msg, size_t len) {
+  FILE *f = fopen(path, append ? "a" : "w");
+  if (!f) {
+    snprintf(msg, len, "cannot write %s: %s", path, strerror(errno));
+    return NULL;
+  }
+  if (!append || fseek(f, 0, SEEK_END) || ftell(f) == 0) { /* new, or none to append to */
+    fputs("stage,time,step,dt,kinetic_energy,ke_ratio", f);
+    for (int k = 0; k < WF_METRIC_COUNT; ++k)
+      if (sc->metrics.enabled[k]) fprintf(f, ",%s", wf_metric_names[k]);
+    fputc('\n', f);
+  }
+  return f;
+}
+
+/**
+ * @brief One row of series.csv for the current state.
+ * @return 0, the metrics' error code, or MPMC_ERR_IO when the row cannot be written (errno)
+ */
+int wf_series_row(FILE *f, mpmc_sim sim, const wf_scene *sc, int stage, long step, double dt, double ke,
+                  double ratio) {
+  double t, m[WF_METRIC_COUNT];
+  mpmc_sim_get_time(sim, &t);
+  const int e = wf_metrics_compute(sim, sc, m);
+  if (e) return e;
+  fprintf(f, "%s,%.9g,%ld,%.6g,%.9g,%.6g", sc->stages[stage].name, t, step, dt, ke, ratio);
+  /* a metric not defined yet (the footing's ratio before its first step) is an empty field,
+     never a NaN; + 0.0 turns -0 into 0 */
+  for (int k = 0; k < WF_METRIC_COUNT; ++k)
+    if (sc->metrics.enabled[k]) isfinite(m[k]) ? fprintf(f, ",%.9g", m[k] + 0.0) : fputc(',', f);
+  fputc('\n', f);
+  /* a full disk shows here first: stop with the reason instead of a silently short series */
+  return fflush(f) || ferror(f) ? MPMC_ERR_IO : 0;
+}
+
+/* Resuming: series.csv at path back to the checkpoint, the rows of at most `steps` steps (a
+ * killed run wrote rows after its last checkpoint, and maybe half a row), through a temporary
+ * file renamed over it.  *kept: the data rows left; an absent file keeps none.  0, or -1
+ * with msg.  The step is the third field; stage names may
+ * hold commas, so it is found from the end of the row (dt, E_k, ratio and the metrics after
+ * it). */
+int wf_series_trim(const char *path, const wf_scene *sc, long steps, int *kept, char *msg, size_t len) {
+  char tmp[WF_PATH + 8];
+  snprintf(tmp, sizeof tmp, "%s.tmp", path);
+  *kept = 0;
+  FILE *in = fopen(path, "r");
+  if (!in) return errno == ENOENT ? 0 : (snprintf(msg, len, "cannot read %s: %s", path, strerror(errno)), -1);
+  FILE *out = fopen(tmp, "w");
+  if (!out) {
+    snprintf(msg, len, "cannot write %s: %s", tmp, strerror(errno));
+    fclose(in);
+    return -1;
+  }
+  int after = 3; /* fields after the step */
+  for (int k = 0; k < WF_METRIC_COUNT; ++k) after += sc->metrics.enabled[k];
+  char *line = NULL;
+  size_t cap = 0;
+  ssize_t n;
+  for (long row = 0; (n = getline(&line, &cap, in)) > 0; ++row) {
+    if (line[n - 1] != '\n') break; /* cut by the kill */
+    int keep = row == 0;            /* the header */
+    if (!keep) {
+      int commas = 0;
+      char *p = line + n - 1;
+      while (p > line && commas < after) commas += *--p == ',';
+      char *end = p; /* the comma after the step */
+      while (p > line && p[-1] != ',') --p;
+      char *stop = NULL;
+      const long st = commas == after && p > line ? strtol(p, &stop, 10) : -1;
+      keep = stop == end && st >= 0 && st <= steps;
+      *kept += keep;
+    }
+    if (keep) fputs(line, out);
+  }
+  free(line);
+  fclose(in);
+  int bad = fflush(out) != 0;
+  bad |= ferror(out) != 0;
+  bad |= fclose(out) != 0;
+  if (bad || rename(tmp, path)) {
+    snprintf(msg, len, "cannot rewrite %s: %s", path, strerror(errno));
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}
+
+/* ---- summary.json ------------------------------------------------------------------------- */
+
+static void json_str(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; ++s) {
+    if (*s == '"' || *s == '\\')
+      fprintf(f, "\\%c", *s);
+    else if ((unsigned char)*s < 0x20)
+      fprintf(f, "\\u%04x", *s);
+    else
+      fputc(*s, f);
+  }
+  fputc('"', f);
+}
+
+static double jnum(double v) { return isfinite(v) ? v : 0.0; }
+
+/**
+ * @brief Write summary.json: the scene, the status (error == NULL: completed, else failed
+ *        with that message), the run's statistics, the records of the stages done and the
+ *        metrics of the current state.  Nothing is written when path cannot be opened.
+ */
+void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const char *error,
+                      const wf_stage_record *rec, int nstages_done, double wall) {
+  const int ok = error == NULL;
+  FILE *f = fopen(path, "w");
+  if (!f) return;
+  mpmc_stats st = {0};
+  int np = 0;
+  if (sim) {
+    mpmc_sim_get_stats(sim, &st);
+    mpmc_sim_get_num_particles(sim, &np);
+  }
+  fputs("{\n  \"scene\": ", f);
+  json_str(f, sc->name);
+  fputs(",\n  \"scene_file\": ", f);
+  json_str(f, sc->path);
+  fprintf(f, ",\n  \"status\": \"%s\",\n", ok ? "completed" : "failed");
+  if (!ok) {
+    fputs("  \"error\": ", f);
+    json_str(f, error);
+    fputs(",\n", f);
+  }
+  fprintf(f, "  \"dim\": %d,\n  \"basis\": \"%s\",\n  \"fbar\": %s,\n  \"cell_size\": %.9g,\n", sc->dim,
+          wf_basis_name(sc->basis), sc->fbar == MPMC_FBAR_TOTAL    ? "\"total\""
+          : sc->fbar == MPMC_FBAR_STABLE ? "\"stable\""
+          : sc->fbar == MPMC_FBAR_PAPER  ? "\"paper\""
+          : sc->fbar                     ? "\"anchored\""
+                                           : "false", sc->h);
+  int kern = MPMC_KERNELS_BASELINE;
+  mpmc_sim_get_kernels(sim, &kern);
+  fprintf(f, "  \"kernels\": \"%s\",\n", mpmc_kernels_name(kern));
+  int sort_every = 0;
+  mpmc_sim_get_sort_interval(sim, &sort_every);
+  fprintf(f, "  \"sort_interval\": %d,\n", sort_every);
+  fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
+  fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
+          st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);
+  fprintf(f, "  \"return_maps\": %lld,\n  \"kinsol_fallbacks\": %lld,\n", (long long)st.return_maps,
+          (long long)st.kinsol_fallbacks);
+  fputs("  \"phase_seconds\": {", f);
+  for (int k = 0; k < MPMC_PHASE_COUNT; ++k)
+    fprintf(f, "%s\"%s\": %.6g", k ? ", " : "", mpmc_phase_name(k), st.phase_seconds[k]);
+  fputs("},\n", f);
+  fputs("  \"stages\": [", f);
+  for (int i = 0; i < nstages_done; ++i) {
+    const wf_stage_record *r = &rec[i];
+    fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
+    json_str(f, r->name);
+    fprintf(f, ", \"sim_time\": %.9g, \"steps\": %ld, \"wall_seconds\": %.6g, \"end\": \"%s\"}", r->sim_time,
+            r->steps, r->wall_seconds, r->reason ? r->reason : "failed");
+  }
+  fputs(nstages_done ? "\n  ]" : "]", f);
+  double m[WF_METRIC_COUNT] = {0};
+  if (sim && np > 0 && wf_metrics_compute(sim, sc, m) == 0)
+    for (int k = 0; k < WF_METRIC_COUNT; ++k)
+      /* all 17 digits: the Fortran example is compared with the front end to 1e-9 relative */
+      if (sc->metrics.enabled[k]) fprintf(f, ",\n  \"%s\": %.17g", wf_metric_names[k], jnum(m[k]));
+  fputs("\n}\n", f);
+  fclose(f);
+}
+
 /* ---- progress ---------------------------------------------------------------------------- */
+double wf_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 void wf_progress_init(wf_progress *p) {
   memset(p, 0, sizeof *p);
   p->tty = isatty(fileno(stderr));

@@ -19,19 +19,6 @@
 #include "mpmc_impl.h"
 #include "wf.h"
 
-double wf_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-typedef struct {
-  char name[WF_NAME];
-  double sim_time, wall_seconds;
-  long steps;
-  const char *reason;
-} stage_record;
-
 /* Where a stage stands between two steps: what a checkpoint inside the stage records so that
  * the resumed stage takes the same steps as the uninterrupted one (the step size is computed
  * every 10 steps counted from the stage's start, and kept in between; the next series row and
@@ -51,7 +38,7 @@ typedef struct {
   int quiet, check;
   FILE *series;
   mpmc_output snap;
-  stage_record *rec;
+  wf_stage_record *rec;
   int *wall_ids;           /* per stage and wall, flattened                              */
   int nwall_ids;
   double t_start;
@@ -428,19 +415,11 @@ static int stage_setup(wf_run *w, int i) {
   return 0;
 }
 
+/* A row of series.csv (report.c); a failure stops the run with the reason. */
 static int series_row(wf_run *w, int stage, long step, double dt, double ke, double ratio) {
-  double t, m[WF_METRIC_COUNT];
-  mpmc_sim_get_time(w->sim, &t);
-  WF_TRY(w, wf_metrics_compute(w->sim, &w->sc, m), "metrics");
-  fprintf(w->series, "%s,%.9g,%ld,%.6g,%.9g,%.6g", w->sc.stages[stage].name, t, step, dt, ke, ratio);
-  /* a metric not defined yet (the footing's ratio before its first step) is an empty field,
-     never a NaN; + 0.0 turns -0 into 0 */
-  for (int k = 0; k < WF_METRIC_COUNT; ++k)
-    if (w->sc.metrics.enabled[k]) isfinite(m[k]) ? fprintf(w->series, ",%.9g", m[k] + 0.0) : fputc(',', w->series);
-  fputc('\n', w->series);
-  /* a full disk shows here first: stop with the reason instead of a silently short series */
-  if (fflush(w->series) || ferror(w->series))
-    return fail(w, MPMC_ERR_IO, "cannot write %s/series.csv: %s", w->out, strerror(errno));
+  const int e = wf_series_row(w->series, w->sim, &w->sc, stage, step, dt, ke, ratio);
+  if (e == MPMC_ERR_IO) return fail(w, e, "cannot write %s/series.csv: %s", w->out, strerror(errno));
+  WF_TRY(w, e, "metrics");
   return 0;
 }
 
@@ -525,7 +504,7 @@ static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf
   const wf_scene *sc = &w->sc;
   const wf_stage *s = &sc->stages[i];
   mpmc_sim sim = w->sim;
-  stage_record *rec = &w->rec[i];
+  wf_stage_record *rec = &w->rec[i];
   snprintf(rec->name, sizeof rec->name, "%s", s->name);
   const double T = s->end_time; /* quasi-static: the maximum time */
   const double w0 = wf_now();
@@ -622,143 +601,10 @@ static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf
   return 0;
 }
 
-static void json_str(FILE *f, const char *s) {
-  fputc('"', f);
-  for (; *s; ++s) {
-    if (*s == '"' || *s == '\\')
-      fprintf(f, "\\%c", *s);
-    else if ((unsigned char)*s < 0x20)
-      fprintf(f, "\\u%04x", *s);
-    else
-      fputc(*s, f);
-  }
-  fputc('"', f);
-}
-
-static double jnum(double v) { return isfinite(v) ? v : 0.0; }
-
-static void write_summary(wf_run *w, int ok, int nstages_done) {
-  char path[WF_PATH];
-  out_path(w, "summary.json", path, sizeof path);
-  FILE *f = fopen(path, "w");
-  if (!f) return;
-  mpmc_stats st = {0};
-  int np = 0;
-  if (w->sim) {
-    mpmc_sim_get_stats(w->sim, &st);
-    mpmc_sim_get_num_particles(w->sim, &np);
-  }
-  const double wall = wf_now() - w->t_start;
-  fputs("{\n  \"scene\": ", f);
-  json_str(f, w->sc.name);
-  fputs(",\n  \"scene_file\": ", f);
-  json_str(f, w->sc.path);
-  fprintf(f, ",\n  \"status\": \"%s\",\n", ok ? "completed" : "failed");
-  if (!ok) {
-    fputs("  \"error\": ", f);
-    json_str(f, w->status_msg);
-    fputs(",\n", f);
-  }
-  fprintf(f, "  \"dim\": %d,\n  \"basis\": \"%s\",\n  \"fbar\": %s,\n  \"cell_size\": %.9g,\n", w->sc.dim,
-          wf_basis_name(w->sc.basis), w->sc.fbar == MPMC_FBAR_TOTAL    ? "\"total\""
-          : w->sc.fbar == MPMC_FBAR_STABLE ? "\"stable\""
-          : w->sc.fbar == MPMC_FBAR_PAPER  ? "\"paper\""
-          : w->sc.fbar                     ? "\"anchored\""
-                                           : "false", w->sc.h);
-  int kern = MPMC_KERNELS_BASELINE;
-  mpmc_sim_get_kernels(w->sim, &kern);
-  fprintf(f, "  \"kernels\": \"%s\",\n", mpmc_kernels_name(kern));
-  int sort_every = 0;
-  mpmc_sim_get_sort_interval(w->sim, &sort_every);
-  fprintf(f, "  \"sort_interval\": %d,\n", sort_every);
-  fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
-  fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
-          st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);
-  fprintf(f, "  \"return_maps\": %lld,\n  \"kinsol_fallbacks\": %lld,\n", (long long)st.return_maps,
-          (long long)st.kinsol_fallbacks);
-  fputs("  \"phase_seconds\": {", f);
-  for (int k = 0; k < MPMC_PHASE_COUNT; ++k)
-    fprintf(f, "%s\"%s\": %.6g", k ? ", " : "", mpmc_phase_name(k), st.phase_seconds[k]);
-  fputs("},\n", f);
-  fputs("  \"stages\": [", f);
-  for (int i = 0; i < nstages_done; ++i) {
-    const stage_record *r = &w->rec[i];
-    fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
-    json_str(f, r->name);
-    fprintf(f, ", \"sim_time\": %.9g, \"steps\": %ld, \"wall_seconds\": %.6g, \"end\": \"%s\"}", r->sim_time,
-            r->steps, r->wall_seconds, r->reason ? r->reason : "failed");
-  }
-  fputs(nstages_done ? "\n  ]" : "]", f);
-  double m[WF_METRIC_COUNT] = {0};
-  if (w->sim && np > 0 && wf_metrics_compute(w->sim, &w->sc, m) == 0)
-    for (int k = 0; k < WF_METRIC_COUNT; ++k)
-      /* all 17 digits: the Fortran example is compared with the front end to 1e-9 relative */
-      if (w->sc.metrics.enabled[k]) fprintf(f, ",\n  \"%s\": %.17g", wf_metric_names[k], jnum(m[k]));
-  fputs("\n}\n", f);
-  fclose(f);
-}
-
-/* Resuming: series.csv back to the checkpoint, the rows of at most `steps` steps (a killed
- * run wrote rows after its last checkpoint, and maybe half a row), through a temporary file
- * renamed over it.  *kept: the data rows left.  The step is the third field; stage names may
- * hold commas, so it is found from the end of the row (dt, E_k, ratio and the metrics after
- * it). */
-static int trim_series(wf_run *w, long steps, int *kept) {
-  char path[WF_PATH], tmp[WF_PATH + 8];
-  out_path(w, "series.csv", path, sizeof path);
-  snprintf(tmp, sizeof tmp, "%s.tmp", path);
-  *kept = 0;
-  FILE *in = fopen(path, "r");
-  if (!in) return errno == ENOENT ? 0 : fail(w, MPMC_ERR_IO, "cannot read %s: %s", path, strerror(errno));
-  FILE *out = fopen(tmp, "w");
-  if (!out) {
-    fclose(in);
-    return fail(w, MPMC_ERR_IO, "cannot write %s: %s", tmp, strerror(errno));
-  }
-  int after = 3; /* fields after the step */
-  for (int k = 0; k < WF_METRIC_COUNT; ++k) after += w->sc.metrics.enabled[k];
-  char *line = NULL;
-  size_t cap = 0;
-  ssize_t n;
-  for (long row = 0; (n = getline(&line, &cap, in)) > 0; ++row) {
-    if (line[n - 1] != '\n') break; /* cut by the kill */
-    int keep = row == 0;            /* the header */
-    if (!keep) {
-      int commas = 0;
-      char *p = line + n - 1;
-      while (p > line && commas < after) commas += *--p == ',';
-      char *end = p; /* the comma after the step */
-      while (p > line && p[-1] != ',') --p;
-      char *stop = NULL;
-      const long st = commas == after && p > line ? strtol(p, &stop, 10) : -1;
-      keep = stop == end && st >= 0 && st <= steps;
-      *kept += keep;
-    }
-    if (keep) fputs(line, out);
-  }
-  free(line);
-  fclose(in);
-  int bad = fflush(out) != 0;
-  bad |= ferror(out) != 0;
-  bad |= fclose(out) != 0;
-  if (bad || rename(tmp, path)) {
-    remove(tmp);
-    return fail(w, MPMC_ERR_IO, "cannot rewrite %s: %s", path, strerror(errno));
-  }
-  return 0;
-}
-
 static int open_outputs(wf_run *w, int append) {
-  char path[WF_PATH], xpath[WF_PATH];
+  char path[WF_PATH], xpath[WF_PATH], msg[WF_MSG];
   out_path(w, "series.csv", path, sizeof path);
-  w->series = fopen(path, append ? "a" : "w");
-  if (!w->series) return fail(w, MPMC_ERR_IO, "cannot write %s: %s", path, strerror(errno));
-  if (!append || fseek(w->series, 0, SEEK_END) || ftell(w->series) == 0) { /* new, or none to append to */
-    fputs("stage,time,step,dt,kinetic_energy,ke_ratio", w->series);
-    for (int k = 0; k < WF_METRIC_COUNT; ++k)
-      if (w->sc.metrics.enabled[k]) fprintf(w->series, ",%s", wf_metric_names[k]);
-    fputc('\n', w->series);
-  }
+  if (!(w->series = wf_series_open(path, &w->sc, append, msg, sizeof msg))) return fail(w, MPMC_ERR_IO, "%s", msg);
   w->resumed = append;
   out_path(w, append ? "snapshots_resumed.h5" : "snapshots.h5", path, sizeof path);
   out_path(w, append ? "snapshots_resumed.xdmf" : "snapshots.xdmf", xpath, sizeof xpath);
@@ -802,17 +648,15 @@ static int finish(wf_run *w, int err) {
   int done = 0;
   while (done < w->sc.nstage && w->rec && w->rec[done].reason) ++done;
   if (!w->check && w->out[0]) {
-    write_summary(w, err == 0, done);
+    char path[WF_PATH];
+    out_path(w, "summary.json", path, sizeof path);
+    wf_summary_write(path, &w->sc, w->sim, err == 0 ? NULL : w->status_msg, w->rec, done, wf_now() - w->t_start);
     if (err == 0 && w->sc.plots && w->sim) {
       char warn[WF_MSG] = "";
       if (wf_plots_write(w->sim, &w->sc, w->out, warn, sizeof warn)) say(w, "warning: plots: %s", warn);
       if (wf_snapplots_plot(&w->sc, w->out, warn, sizeof warn)) say(w, "warning: snapshot plots: %s", warn);
     }
-    if (err == 0) {
-      char path[WF_PATH];
-      out_path(w, "summary.json", path, sizeof path);
-      say(w, "done in %.1f s: %s", wf_now() - w->t_start, path);
-    }
+    if (err == 0) say(w, "done in %.1f s: %s", wf_now() - w->t_start, path);
   }
   if (w->series) fclose(w->series);
 #ifdef _OPENMP
@@ -936,7 +780,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   long steps = 0;
   char **sets = calloc(1, sizeof *sets);
   int *walls = NULL;
-  stage_record *done = NULL;
+  wf_stage_record *done = NULL;
   int bad = meta == NULL || strncmp(meta, "mpmc-workflow 1\n", 16) != 0;
   for (char *save = NULL, *line = bad ? NULL : strtok_r(meta, "\n", &save); line && !bad;
        line = strtok_r(NULL, "\n", &save)) {
@@ -959,12 +803,12 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
       bad = !w2;
       if (w2) bad = sscanf(line, "wall %d", &(walls = w2)[nwall++]) != 1;
     } else if (!strncmp(line, "done ", 5)) {
-      stage_record *d2 = realloc(done, sizeof *done * (size_t)(ndone + 1));
+      wf_stage_record *d2 = realloc(done, sizeof *done * (size_t)(ndone + 1));
       bad = !d2;
       if (d2) {
         done = d2;
         char reason[32];
-        stage_record *r = &done[ndone++];
+        wf_stage_record *r = &done[ndone++];
         memset(r, 0, sizeof *r);
         bad = sscanf(line, "done %lf %ld %lf %31s", &r->sim_time, &r->steps, &r->wall_seconds, reason) != 4;
         r->reason = !strcmp(reason, "quasi_static") ? "quasi_static" : !strcmp(reason, "time") ? "time" : "max_time";
@@ -1003,7 +847,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
    * raised (an end by time; not one that came to rest) */
   if (!err && stage == w.sc.nstage && ndone == stage && stage > 0) {
     const wf_stage *last = &w.sc.stages[stage - 1];
-    const stage_record *r = &done[stage - 1];
+    const wf_stage_record *r = &done[stage - 1];
     if (strcmp(r->reason, "quasi_static") != 0 && last->end_time > r->sim_time * (1 + 1e-9)) {
       /* the last stage again, at its old end, set up; ke_max is used by quasi-static ends
        * only, the step size is computed on the first step */
@@ -1047,7 +891,12 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     if (wf_metrics_init(w.sim, &w.sc)) err = ctx->last_code;
     say(&w, "resuming %s at stage %d/%d (%s), %.4g s into it", scene, stage + 1, w.sc.nstage,
         w.sc.stages[stage].name, clock.t_stage);
-    if (!err) err = trim_series(&w, steps, &w.series_rows) ? ctx->last_code : 0;
+    if (!err) {
+      char series[WF_PATH], msg[WF_MSG];
+      out_path(&w, "series.csv", series, sizeof series);
+      if (wf_series_trim(series, &w.sc, steps, &w.series_rows, msg, sizeof msg))
+        err = fail(&w, MPMC_ERR_IO, "resume: %s", msg);
+    }
     if (!err) err = open_outputs(&w, 1) ? ctx->last_code : 0;
     if (!err) {
       if (setup && w.sc.stages[stage].has_gravity) mpmc_sim_set_gravity(w.sim, w.sc.stages[stage].gravity);

@@ -2,8 +2,8 @@
  *
  * scene.c    YAML -> a small tree with file:line:column on every node, --set overrides,
  *            typed and range-checked reading of that tree into wf_scene
- * run.c      mpmc_workflow_run: builds the simulation and runs the stages
- * report.c   progress line/bar, series.csv, summary.json, metrics
+ * run.c      mpmc_workflow_run: builds the simulation and runs the stages (calls report.c)
+ * report.c   progress line/bar, series.csv, summary.json, metrics (calls nothing in run.c)
  * plot.c     PNG plots through gnuplot (a child process)
  * gmsh_plugin.c  libmpmc_gmsh loaded with dlopen only when a scene seeds from gmsh
  */
@@ -190,6 +190,20 @@ const char *wf_basis_name(int basis);
 const char *wf_model_name(int model);
 
 /* ---- reports (report.c) ---------------------------------------------------------- */
+/* What a stage did: summary.json's "stages" and the checkpoints' records (run.c). */
+typedef struct {
+  char name[WF_NAME];
+  double sim_time, wall_seconds;
+  long steps;
+  const char *reason;        /* "time", "quasi_static", "max_time"; NULL: not done        */
+} wf_stage_record;
+FILE *wf_series_open(const char *path, const wf_scene *sc, int append, char *msg, size_t len);
+int wf_series_row(FILE *f, mpmc_sim sim, const wf_scene *sc, int stage, long step, double dt, double ke,
+                  double ratio);
+/* series.csv cut back to the rows of at most `steps` steps (resume); 0, or -1 with msg. */
+int wf_series_trim(const char *path, const wf_scene *sc, long steps, int *kept, char *msg, size_t len);
+void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const char *error,
+                      const wf_stage_record *rec, int nstages_done, double wall);
 extern const char *const wf_metric_names[WF_METRIC_COUNT];
 /* Compute the enabled metrics of the current state into values[WF_METRIC_COUNT]. */
 int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *values);
@@ -242,6 +256,7 @@ int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t
 int wf_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
                  int material, int *first, int *count, char *msg, size_t len);
 
+/* Monotonic wall-clock seconds (report.c). */
 double wf_now(void);
 
 #endif
