@@ -86,6 +86,54 @@ static void plot_bearing(FILE *g, const wf_scene *sc) {
   fprintf(g, "set autoscale y\nset key default\n"); /* leave the settings as found */
 }
 
+/* ---- gnuplot, for plot.c and snapshot_plots.c ------------------------------------------- */
+
+/**
+ * @brief Start gnuplot as a child drawing into outdir (its output to outdir/log), set up with
+ *        CSV input and the colour palette.  NULL with a warning in warn when it cannot run:
+ *        outdir holds quote characters, gnuplot is missing (nopng: what the run has
+ *        instead, for the warning), or it does not start.  what: "plots" or the like.
+ */
+FILE *wf_gnuplot_open(const char *outdir, const char *log, const char *what, const char *nopng, char *warn,
+                      size_t len) {
+  if (strpbrk(outdir, "\"'\\`$")) {
+    snprintf(warn, len, "output path has quote characters; %s skipped", what);
+    return NULL;
+  }
+  if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
+    snprintf(warn, len, "gnuplot not found (Debian package gnuplot-nox): %s", nopng);
+    return NULL;
+  }
+  char cmd[WF_PATH + 64];
+  snprintf(cmd, sizeof cmd, "gnuplot >'%s/%s' 2>&1", outdir, log);
+  FILE *g = popen(cmd, "w");
+  if (!g) {
+    snprintf(warn, len, "cannot start gnuplot");
+    return NULL;
+  }
+  fprintf(g, "cd \"%s\"\nset datafile separator ','\n", outdir);
+  fprintf(g, "set palette defined (0 '#313695', 1 '#4575b4', 2 '#74add1', 3 '#abd9e9', 4 '#fee090', "
+             "5 '#fdae61', 6 '#f46d43', 7 '#d73027', 8 '#a50026')\n");
+  return g;
+}
+
+/** @brief The PNG terminal at width x height pixels (pngcairo where gnuplot has it). */
+void wf_gnuplot_terminal(FILE *g, int width, int height, int font) {
+  fprintf(g, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size %d,%d font ',%d' } "
+             "else { set terminal png size %d,%d }\n",
+          width, height, font, width, height);
+}
+
+/** @brief Wait for gnuplot: 0, or 1 with a warning naming outdir/log when it failed. */
+int wf_gnuplot_close(FILE *g, const char *outdir, const char *log, char *warn, size_t len) {
+  const int st = pclose(g);
+  if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+    snprintf(warn, len, "gnuplot failed (see %s/%s)", outdir, log);
+    return 1;
+  }
+  return 0;
+}
+
 /** @brief Write final_state.csv and the PNG plots into outdir. */
 int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *warn, size_t len) {
   const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
@@ -98,33 +146,17 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
     snprintf(warn, len, "cannot write %s", path);
     return 1;
   }
-  if (strpbrk(outdir, "\"'\\`$")) {
-    snprintf(warn, len, "output path has quote characters; plots skipped");
-    return 1;
-  }
-  if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
-    snprintf(warn, len, "gnuplot not found (Debian package gnuplot-nox): no PNG plots, the data is in final_state.csv and series.csv");
-    return 1;
-  }
-  char cmd[WF_PATH + 64];
-  snprintf(cmd, sizeof cmd, "gnuplot >'%s/plots.log' 2>&1", outdir);
-  FILE *g = popen(cmd, "w");
-  if (!g) {
-    snprintf(warn, len, "cannot start gnuplot");
-    return 1;
-  }
+  FILE *g = wf_gnuplot_open(outdir, "plots.log", "plots",
+                            "no PNG plots, the data is in final_state.csv and series.csv", warn, len);
+  if (!g) return 1;
   const char *ax = "xyz";
   double t = 0;
   mpmc_sim_get_time(sim, &t);
   const int d = sc->dim;
   /* columns of final_state.csv: coordinates, mean stress, eps_p */
   const int cx = hx + 1, cy = vy + 1, cp = d + 1, ce = d + 2;
-  fprintf(g, "cd \"%s\"\nset datafile separator ','\n", outdir);
-  fprintf(g, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1400,700 font ',12' } "
-             "else { set terminal png size 1400,700 }\n");
+  wf_gnuplot_terminal(g, 1400, 700, 12);
   fprintf(g, "set size ratio -1\nset xlabel '%c [m]'\nset ylabel '%c [m]'\nset grid\n", ax[hx], ax[vy]);
-  fprintf(g, "set palette defined (0 '#313695', 1 '#4575b4', 2 '#74add1', 3 '#abd9e9', 4 '#fee090', "
-             "5 '#fdae61', 6 '#f46d43', 7 '#d73027', 8 '#a50026')\n");
   fprintf(g, "set output 'final_mean_stress.png'\n");
   fprintf(g, "set title '%s%s: mean stress p = tr(sigma)/3 [kPa] at t = %.3f s (tension > 0)' noenhanced\n", sc->name,
           d == 3 ? " (side view)" : "", t);
@@ -156,10 +188,5 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
   if (!any) fprintf(g, "plot 'series.csv' skip 1 using 2:6 with lines lw 2 title 'E_k / E_k,max'");
   fprintf(g, "\nunset multiplot\n");
   if (sc->metrics.enabled[WF_METRIC_BEARING]) plot_bearing(g, sc);
-  const int st = pclose(g);
-  if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-    snprintf(warn, len, "gnuplot failed (see %s/plots.log)", outdir);
-    return 1;
-  }
-  return 0;
+  return wf_gnuplot_close(g, outdir, "plots.log", warn, len);
 }

@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include "wf.h"
 
@@ -167,25 +166,11 @@ static int exists(const char *path) {
  */
 int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t len) {
   if (sc->nsnapplot == 0) return 0;
-  if (strpbrk(outdir, "\"'\\`$")) {
-    snprintf(warn, len, "output path has quote characters; snapshot plots skipped");
-    return 1;
-  }
-  if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
-    snprintf(warn, len, "gnuplot not found (Debian package gnuplot-nox): no snapshot PNGs, the data is in snap_*.csv");
-    return 1;
-  }
-  char cmd[WF_PATH + 64];
-  snprintf(cmd, sizeof cmd, "gnuplot >'%s/snapshot_plots.log' 2>&1", outdir);
-  FILE *g = popen(cmd, "w");
-  if (!g) {
-    snprintf(warn, len, "cannot start gnuplot");
-    return 1;
-  }
+  FILE *g = wf_gnuplot_open(outdir, "snapshot_plots.log", "snapshot plots",
+                            "no snapshot PNGs, the data is in snap_*.csv", warn, len);
+  if (!g) return 1;
   int missing = 0;
-  fprintf(g, "cd \"%s\"\nset datafile separator ','\nset grid\n", outdir);
-  fprintf(g, "set palette defined (0 '#313695', 1 '#4575b4', 2 '#74add1', 3 '#abd9e9', 4 '#fee090', "
-             "5 '#fdae61', 6 '#f46d43', 7 '#d73027', 8 '#a50026')\n");
+  fprintf(g, "set grid\n");
   int hx, vy;
   view_axes(sc, &hx, &vy);
   for (int k = 0; k < sc->nsnapplot; ++k) {
@@ -221,17 +206,14 @@ int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t
     fprintf(g, "set size ratio -1\nset xlabel '%c [m]'\nset ylabel '%c [m]'\nset cblabel '%s' noenhanced\n", "xyz"[hx],
             "xyz"[vy], color_labels[p->color]);
     for (int j = 0; j < n; ++j) {
-      fprintf(g, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size 1200,800 font ',12' } "
-                 "else { set terminal png size 1200,800 }\n");
+      wf_gnuplot_terminal(g, 1200, 800, 12);
       fprintf(g, "set output 'snapshot_%s_t%g_%s.png'\n", stage, when[j], col);
       fprintf(g, "set title '%s%s: %s at t = %g s of stage %s' noenhanced\n", sc->name, sc->dim == 3 ? " (side view)" : "",
               col, when[j], stage);
       fprintf(g, "plot '%s' skip 2 using 1:2:3 with points pt 7 ps 0.4 lc palette notitle\n", files[j]);
     }
     const int cols = n < 2 ? 1 : 2, rows = (n + cols - 1) / cols;
-    fprintf(g, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) { set terminal pngcairo size %d,%d font ',11' } "
-               "else { set terminal png size %d,%d }\n",
-            900 * cols, 600 * rows, 900 * cols, 600 * rows);
+    wf_gnuplot_terminal(g, 900 * cols, 600 * rows, 11);
     fprintf(g, "set output 'snapshots_%s_%s.png'\nset multiplot layout %d,%d title '%s: %s, stage %s' noenhanced\n", stage, col,
             rows, cols, sc->name, col, stage);
     for (int j = 0; j < n; ++j)
@@ -239,11 +221,7 @@ int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t
               files[j]);
     fprintf(g, "unset multiplot\nset output\n");
   }
-  const int st = pclose(g);
-  if (st == -1 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
-    snprintf(warn, len, "gnuplot failed (see %s/snapshot_plots.log)", outdir);
-    return 1;
-  }
+  if (wf_gnuplot_close(g, outdir, "snapshot_plots.log", warn, len)) return 1;
   if (missing) {
     snprintf(warn, len, "%d requested snapshot time(s) were never reached (after the stage's end?)", missing);
     return 1;

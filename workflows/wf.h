@@ -4,7 +4,8 @@
  *            typed and range-checked reading of that tree into wf_scene
  * run.c      mpmc_workflow_run: builds the simulation and runs the stages (calls report.c)
  * report.c   progress line/bar, series.csv, summary.json, metrics (calls nothing in run.c)
- * plot.c     PNG plots through gnuplot (a child process)
+ * plot.c     PNG plots through gnuplot (a child process; its start and end, wf_gnuplot_*,
+ *            shared with snapshot_plots.c)
  * gmsh_plugin.c  libmpmc_gmsh loaded with dlopen only when a scene seeds from gmsh
  */
 #ifndef MPMC_WF_H
@@ -238,6 +239,13 @@ void wf_rigid_free(wf_scene *sc);
 /* Final state (coloured by mean stress and equivalent plastic strain) and time series.
  * Returns 0, or 1 when gnuplot is missing or failed (a warning, not an error). */
 int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *warn, size_t len);
+
+/* gnuplot as a child process, set up for CSV data and the palette (NULL with a warning when
+ * it cannot run), a PNG terminal, and its end (0, or 1 with a warning). */
+FILE *wf_gnuplot_open(const char *outdir, const char *log, const char *what, const char *nopng, char *warn,
+                      size_t len);
+void wf_gnuplot_terminal(FILE *g, int width, int height, int font);
+int wf_gnuplot_close(FILE *g, const char *outdir, const char *log, char *warn, size_t len);
 
 /* Keep metrics defined at the end of a stage (hydrostatic_pressure_error); report.c. */
 int wf_metrics_stage_end(mpmc_sim sim, wf_scene *sc, int stage);
