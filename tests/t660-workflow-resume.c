@@ -67,30 +67,6 @@ static void write_text(const char *path, const char *text) {
   fclose(f);
 }
 
-/* The whole of a file, malloc'ed and NUL-terminated ("" when absent). */
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  char *buf = NULL;
-  size_t n = 0, cap = 0;
-  if (f) {
-    for (;;) {
-      if (n + 4096 + 1 > cap) {
-        cap = 2 * cap + 8192;
-        buf = realloc(buf, cap);
-        assert_non_null(buf);
-      }
-      const size_t r = fread(buf + n, 1, 4096, f);
-      n += r;
-      if (r == 0) break;
-    }
-    fclose(f);
-  }
-  if (!buf) buf = malloc(1);
-  assert_non_null(buf);
-  buf[n] = '\0';
-  return buf;
-}
-
 /* `mpmc` with arguments (NULL-terminated), output to DIR/cli.log; the child's pid. */
 static pid_t spawn_cli(const char *a0, ...) {
   const char *argv[16] = {MPMC_CLI, a0};
@@ -119,7 +95,8 @@ static int wait_cli(pid_t pid) {
 
 /* Rows of series.csv that belong to stage `name`. */
 static int rows_of(const char *series, const char *name) {
-  char *s = slurp(series), key[64];
+  if (!test_exists(series)) return 0;
+  char *s = test_slurp(series), key[64];
   snprintf(key, sizeof key, "\n%s,", name);
   int n = 0;
   for (const char *p = strstr(s, key); p; p = strstr(p + 1, key)) ++n;
@@ -205,7 +182,7 @@ static void expect_same_state(const char *a, const char *b) {
 
 /* The two series.csv files are the same bytes; else the first line that differs. */
 static void expect_same_series(const char *ref_path, const char *got_path, const char *what) {
-  char *ref = slurp(ref_path), *got = slurp(got_path);
+  char *ref = test_slurp(ref_path), *got = test_slurp(got_path);
   size_t i = 0, start = 0;
   int line = 1;
   for (; ref[i] && ref[i] == got[i]; ++i)
@@ -264,11 +241,6 @@ static void test_resume_stage_start(void **state) {
   expect_same_series(DIR "/ref/series.csv", DIR "/kill2/series.csv", "after a kill and a resume from a stage's start");
 }
 
-static int exists(const char *p) {
-  struct stat s;
-  return stat(p, &s) == 0;
-}
-
 static void test_force(void **state) {
   (void)state;
   const char *scene = DIR "/fall.yaml";
@@ -296,11 +268,11 @@ static void test_force(void **state) {
     fail_msg("mpmc run --force failed (see %s/cli.log)", DIR);
   for (size_t i = 1; i < sizeof old / sizeof old[0]; ++i) {
     snprintf(path, sizeof path, "%s/force/%s", DIR, old[i]);
-    if (exists(path)) fail_msg("mpmc run --force left the earlier run's %s", path);
+    if (test_exists(path)) fail_msg("mpmc run --force left the earlier run's %s", path);
   }
   for (size_t i = 0; i < sizeof mine / sizeof mine[0]; ++i) {
     snprintf(path, sizeof path, "%s/force/%s", DIR, mine[i]);
-    if (!exists(path)) fail_msg("mpmc run --force removed %s, a file the run does not write", path);
+    if (!test_exists(path)) fail_msg("mpmc run --force removed %s, a file the run does not write", path);
   }
   /* the earlier checkpoint.h5 (here not even a checkpoint) is replaced by the run's own */
   mpmc_context ctx;
@@ -311,7 +283,7 @@ static void test_force(void **state) {
   mpmc_sim_destroy(&sim);
   test_ctx = NULL;
   mpmc_context_destroy(&ctx);
-  char *sum = slurp(DIR "/force/summary.json");
+  char *sum = test_slurp(DIR "/force/summary.json");
   if (!strstr(sum, "\"completed\"")) fail_msg("summary.json of the forced run: %s", sum);
   free(sum);
 }
