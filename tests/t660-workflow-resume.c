@@ -126,23 +126,32 @@ static void kill_at(pid_t pid, const char *out, const char *name, int rows) {
   fail_msg("the run into %s never reached %d series rows of stage '%s'", out, rows, name);
 }
 
-/* The checkpoint in out lies inside a stage (set up, some time into it). */
-static void expect_mid_stage(const char *out, const char *what) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/checkpoint.h5", out);
+/* The workflow's record in checkpoint `path` (malloc'ed); fails the test when it does not read. */
+static char *checkpoint_meta(const char *path) {
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
   mpmc_sim sim = NULL;
   char *meta = NULL;
   TCALL(mpmc_sim_checkpoint_read(ctx, path, &sim, &meta));
-  const char *setup = strstr(meta, "\nsetup "), *ts = strstr(meta, "\nstage_time ");
-  if (!setup || !ts || atoi(setup + 7) != 1 || !(strtod(ts + 12, NULL) > 0))
-    fail_msg("%s: expected a checkpoint inside a stage, its record is:\n%s", what, meta);
+  char *copy = strdup(meta);
+  assert_non_null(copy);
   mpmc_free(meta);
   mpmc_sim_destroy(&sim);
   test_ctx = NULL;
   mpmc_context_destroy(&ctx);
+  return copy;
+}
+
+/* The checkpoint in out lies inside a stage (set up, some time into it). */
+static void expect_mid_stage(const char *out, const char *what) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/checkpoint.h5", out);
+  char *meta = checkpoint_meta(path);
+  const char *setup = strstr(meta, "\nsetup "), *ts = strstr(meta, "\nstage_time ");
+  if (!setup || !ts || atoi(setup + 7) != 1 || !(strtod(ts + 12, NULL) > 0))
+    fail_msg("%s: expected a checkpoint inside a stage, its record is:\n%s", what, meta);
+  free(meta);
 }
 
 /* Every particle array, the time and the step count of two checkpoints: the same bits. */
@@ -223,18 +232,10 @@ static void test_resume_stage_start(void **state) {
       wait_cli(spawn_cli("run", scene, "--out", DIR "/ref", "--quiet", NULL)) != 0)
     fail_msg("the uninterrupted run failed (see %s/cli.log)", DIR);
   kill_at(spawn_cli("run", scene, "--out", DIR "/kill2", "--quiet", NULL), DIR "/kill2", "collapse", 20);
-  mpmc_context ctx;
-  TCALL(mpmc_context_create(&ctx));
-  test_ctx = ctx;
-  mpmc_sim sim = NULL;
-  char *meta = NULL;
-  TCALL(mpmc_sim_checkpoint_read(ctx, DIR "/kill2/checkpoint.h5", &sim, &meta));
+  char *meta = checkpoint_meta(DIR "/kill2/checkpoint.h5");
   if (!strstr(meta, "\nstage 1\nsetup 0\n"))
     fail_msg("expected the checkpoint at the start of stage 1 (collapse), its record is:\n%s", meta);
-  mpmc_free(meta);
-  mpmc_sim_destroy(&sim);
-  test_ctx = NULL;
-  mpmc_context_destroy(&ctx);
+  free(meta);
   if (wait_cli(spawn_cli("resume", DIR "/kill2", "--quiet", NULL)) != 0)
     fail_msg("the resume failed (see %s/cli.log)", DIR);
   expect_same_state(DIR "/ref/checkpoint.h5", DIR "/kill2/checkpoint.h5");
@@ -275,14 +276,7 @@ static void test_force(void **state) {
     if (!test_exists(path)) fail_msg("mpmc run --force removed %s, a file the run does not write", path);
   }
   /* the earlier checkpoint.h5 (here not even a checkpoint) is replaced by the run's own */
-  mpmc_context ctx;
-  TCALL(mpmc_context_create(&ctx));
-  test_ctx = ctx;
-  mpmc_sim sim = NULL;
-  TCALL(mpmc_sim_checkpoint_read(ctx, DIR "/force/checkpoint.h5", &sim, NULL));
-  mpmc_sim_destroy(&sim);
-  test_ctx = NULL;
-  mpmc_context_destroy(&ctx);
+  free(checkpoint_meta(DIR "/force/checkpoint.h5"));
   char *sum = test_slurp(DIR "/force/summary.json");
   if (!strstr(sum, "\"completed\"")) fail_msg("summary.json of the forced run: %s", sum);
   free(sum);
