@@ -37,7 +37,7 @@ module mpmc
   ! F-bar projection: off, Algorithm 1 as published, projection of det F, projection of
   ! det F onto a space one order below the basis
   integer(c_int), parameter, public :: MPMC_FBAR_OFF = 0, MPMC_FBAR_PAPER = 1, &
-    MPMC_FBAR_TOTAL = 2, MPMC_FBAR_STABLE = 3
+    MPMC_FBAR_TOTAL = 2, MPMC_FBAR_STABLE = 3, MPMC_FBAR_ANCHORED = 4
   ! walls
   integer(c_int), parameter, public :: MPMC_WALL_FIXED = 0, MPMC_WALL_SLIP = 1, &
     MPMC_WALL_SEPARABLE = 2

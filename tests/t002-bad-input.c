@@ -43,7 +43,7 @@ static void test_bad_input(void **state) {
   TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.5));
   /* options */
   EXPECT(mpmc_sim_set_basis(sim, 7), MPMC_ERR_ARG, "basis = 7");
-  EXPECT(mpmc_sim_set_fbar(sim, 4), MPMC_ERR_ARG, "fbar = 4");
+  EXPECT(mpmc_sim_set_fbar(sim, 5), MPMC_ERR_ARG, "fbar = 5");
   EXPECT(mpmc_sim_set_fbar(sim, -1), MPMC_ERR_ARG, "fbar = -1");
   EXPECT(mpmc_sim_set_flip_blend(sim, 1.5), MPMC_ERR_ARG, "FLIP/PIC blend = 1.5");
   EXPECT(mpmc_sim_set_damping(sim, 1.0), MPMC_ERR_ARG, "local damping alpha = 1");

@@ -59,6 +59,7 @@ static void homogeneous(int dim, int basis, int mode) {
     for (int k = 0; k < dim * dim; ++k) sim->p.dF[q * dim * dim + k] = F[k];
     sim->p.Jbar[q] = 1.1; /* Jbar^n; the points' J already holds J^n dJ */
     sim->p.J[q] = 1.1 * dJ;
+    if (sim->p.Janc) sim->p.Janc[q] = 1.1; /* anchored to Jbar^n / J^n = 1 */
   }
   TCALL(mpmc_fbar(sim, 0));
   for (int q = 0; q < n; ++q) {
@@ -159,7 +160,7 @@ static double nodal_mode(int dim, int basis, int mode) {
 
 /* check(dim, basis, form) for both dimensions, every basis and every F-bar form */
 static void every_case(void (*check)(int, int, int)) {
-  for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_STABLE; ++m)
+  for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_ANCHORED; ++m)
     for (int b = 0; b < 4; ++b)
       for (int d = 2; d <= 3; ++d) check(d, b, m);
 }
@@ -210,7 +211,7 @@ static mpmc_sim falling(mpmc_context ctx, int form, int *n) {
 
 static void test_positions_held(void **state) {
   (void)state;
-  for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_STABLE; ++form) {
+  for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_ANCHORED; ++form) {
     mpmc_context ctx;
     TCALL(mpmc_context_create(&ctx));
     test_ctx = ctx;
@@ -241,7 +242,7 @@ static void test_positions_held(void **state) {
 static void test_fb_cleared(void **state) {
   (void)state;
   for (int dim = 2; dim <= 3; ++dim)
-    for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_STABLE; ++m)
+    for (int m = MPMC_FBAR_PAPER; m <= MPMC_FBAR_ANCHORED; ++m)
       for (int b = 0; b < 4; ++b) {
         mpmc_context ctx;
         TCALL(mpmc_context_create(&ctx));
@@ -496,7 +497,7 @@ static void test_deferred_gather(void **state) {
   for (int model = 0; model < SLUMP_MODELS; ++model)
   for (int two = 0; two <= 1; ++two)
   for (int dim = 2; dim <= 3; ++dim)
-    for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_STABLE; ++form)
+    for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_ANCHORED; ++form)
       for (int b = 0; b < 4; ++b) {
         mpmc_context ctx;
         TCALL(mpmc_context_create(&ctx));
@@ -568,7 +569,7 @@ static double projected_at(const mpmc_sim sim, const double *xs, int q) {
 static void test_gather_at_xn(void **state) {
   (void)state;
   for (int dim = 2; dim <= 3; ++dim)
-    for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_STABLE; ++form)
+    for (int form = MPMC_FBAR_PAPER; form <= MPMC_FBAR_ANCHORED; ++form)
       for (int b = 0; b < 4; ++b)
         for (int threads = 1; threads <= 2; ++threads) {
           mpmc_context ctx;
@@ -608,8 +609,8 @@ static void test_gather_at_xn(void **state) {
  * each change of form between steps still projects at x^n (test_gather_at_xn's check). */
 static void test_kept_fields(void **state) {
   (void)state;
-  static const int forms[] = {MPMC_FBAR_PAPER, MPMC_FBAR_STABLE, MPMC_FBAR_TOTAL,
-                              MPMC_FBAR_OFF,   MPMC_FBAR_PAPER};
+  static const int forms[] = {MPMC_FBAR_PAPER, MPMC_FBAR_STABLE,   MPMC_FBAR_TOTAL,
+                              MPMC_FBAR_OFF,   MPMC_FBAR_ANCHORED, MPMC_FBAR_PAPER};
   mpmc_context ctx;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
@@ -625,10 +626,10 @@ static void test_kept_fields(void **state) {
     TCALL(mpmc_sim_step(sim, dt));
     const int kept = form != MPMC_FBAR_OFF && form != MPMC_FBAR_STABLE;
     if ((sim->p.xn != NULL) != (form == MPMC_FBAR_STABLE) || (sim->p.xoff != NULL) != kept ||
-        (sim->p.xnode != NULL) != kept)
-      fail_msg("form %d: x^n %s, offsets %s, first nodes %s", form,
+        (sim->p.xnode != NULL) != kept || (sim->p.Janc != NULL) != (form == MPMC_FBAR_ANCHORED))
+      fail_msg("form %d: x^n %s, offsets %s, first nodes %s, anchored J %s", form,
                sim->p.xn ? "kept" : "absent", sim->p.xoff ? "kept" : "absent",
-               sim->p.xnode ? "kept" : "absent");
+               sim->p.xnode ? "kept" : "absent", sim->p.Janc ? "kept" : "absent");
     double worst = 0.0;
     for (int q = 0; q < n && form != MPMC_FBAR_OFF; ++q) {
       const double e = fabs(projected_at(sim, xn, q) - sim->p.Jbar[q]);

@@ -29,7 +29,7 @@ static mpmc_sim build(int nthreads) {
   const double lo[2] = {0, 0}, hi[2] = {6, 4}, g[2] = {0.3, -9.81};
   int m1, m2;
   TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.25));
-  TCALL(mpmc_sim_set_fbar(sim, 1));
+  TCALL(mpmc_sim_set_fbar(sim, MPMC_FBAR_ANCHORED));
   TCALL(mpmc_sim_set_flip_blend(sim, 0.9));
   TCALL(mpmc_sim_set_gravity(sim, g));
   TCALL(mpmc_sim_set_damping(sim, 0.05));

@@ -920,7 +920,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   sc->nstage = ss->n;
   sc->stages = calloc((size_t)ss->n, sizeof *sc->stages);
   if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
-  static const char *const keys[] = {"name", "gravity", "damping", "walls", "remove_walls", "tractions",
+  static const char *const keys[] = {"name", "gravity", "damping", "flip", "walls", "remove_walls", "tractions",
                                      "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
                                      "snapshots", "series_points", "rigid_bodies", "force_dt", NULL};
   static const char *const end_keys[] = {"time", "kinetic_energy_ratio", "max_time", "min_time", NULL};
@@ -939,6 +939,9 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     }
     const range damp = {0, 1, 0, 1};
     if (get_num(r, n, p, "damping", 0, 0, damp, &s->damping)) return -1;
+    /* absent: the scene's blend (a quasi-static stage of a FLIP scene takes a little PIC:
+     * docs/theory.md) */
+    if (get_num(r, n, p, "flip", 0, -1.0, UNIT, &s->flip)) return -1;
     const range srf = {0, INFINITY, 1, 0};
     /* 0: unchanged from the previous stage */
     if (get_num(r, n, p, "strength_reduction", 0, 0.0, srf, &s->strength_reduction)) return -1;
@@ -1192,21 +1195,24 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
       return fail_at(r, map_get(g, "cell_size"), "grid.cell_size",
                      "must not exceed the grid's extent %g along axis %d (got %g)", sc->hi[a] - sc->lo[a], a, sc->h);
   if (get_enum(r, root, "", "basis", 0, MPMC_BASIS_BSPLINE2, basis_words, &sc->basis)) return -1;
-  /* fbar: true (= paper, Algorithm 1 as published), false, paper, total or stable */
+  /* fbar: true (= anchored, the default), false, anchored, paper (Algorithm 1 as published),
+   * total or stable (docs/theory.md) */
   {
     const wf_node *fn = map_get(root, "fbar");
-    static const char *const words[] = {"paper", "total", "stable"};
-    static const int modes[] = {MPMC_FBAR_PAPER, MPMC_FBAR_TOTAL, MPMC_FBAR_STABLE};
+    static const char *const words[] = {"paper", "total", "stable", "anchored"};
+    static const int modes[] = {MPMC_FBAR_PAPER, MPMC_FBAR_TOTAL, MPMC_FBAR_STABLE,
+                                MPMC_FBAR_ANCHORED};
     sc->fbar = -1;
-    if (!fn) sc->fbar = MPMC_FBAR_PAPER;
-    for (int i = 0; i < 3 && fn && fn->kind == WF_SCALAR && !fn->quoted; ++i)
+    if (!fn) sc->fbar = MPMC_FBAR_ANCHORED;
+    for (int i = 0; i < 4 && fn && fn->kind == WF_SCALAR && !fn->quoted; ++i)
       if (!strcmp(fn->value, words[i])) sc->fbar = modes[i];
     if (sc->fbar < 0 && fn) {
       const int b = bool_word(fn);
       if (b < 0)
-        return fail_at(r, fn, "fbar", "expected true, false, paper, total or stable (got '%s')",
+        return fail_at(r, fn, "fbar", "expected true, false, anchored, paper, total or stable "
+                       "(got '%s')",
                        shown(fn));
-      sc->fbar = b ? MPMC_FBAR_PAPER : MPMC_FBAR_OFF;
+      sc->fbar = b ? MPMC_FBAR_ANCHORED : MPMC_FBAR_OFF;
     }
   }
   if (get_num(r, root, "", "flip", 0, 1.0, UNIT, &sc->flip)) return -1;

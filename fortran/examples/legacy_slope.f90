@@ -22,7 +22,7 @@ program legacy_slope
   real(c_double), parameter :: grid_hi(2) = [55.0_c_double, 6.0_c_double]
   real(c_double) :: cell = 0.25_c_double                            ! m
   integer(c_int), parameter :: basis = MPMC_BASIS_UGIMP
-  integer(c_int) :: fbar = MPMC_FBAR_PAPER                         ! scene: fbar: true
+  integer(c_int) :: fbar = MPMC_FBAR_ANCHORED                      ! scene: fbar: true
   real(c_double), parameter :: flip = 0.99_c_double                 ! FLIP/PIC blend (eq 13)
   ! sensitive clay (paper section 4.4), Hencky-J2 with exponential softening
   real(c_double), parameter :: E = 25.0e6_c_double, nu = 0.49_c_double, rho = 2150.0_c_double
@@ -142,7 +142,8 @@ contains
       read (val, *, iostat=ios) cell
     case ('fbar')
       fbar = -1
-      if (val == 'true' .or. val == 'paper') fbar = MPMC_FBAR_PAPER
+      if (val == 'true' .or. val == 'anchored') fbar = MPMC_FBAR_ANCHORED
+      if (val == 'paper') fbar = MPMC_FBAR_PAPER
       if (val == 'total') fbar = MPMC_FBAR_TOTAL
       if (val == 'stable') fbar = MPMC_FBAR_STABLE
       if (val == 'false') fbar = MPMC_FBAR_OFF

@@ -68,8 +68,11 @@ typedef enum {
   MPMC_FBAR_PAPER = 1, /* Algorithm 1 as published: projects Jbar^n dJ (eq 26)         */
   MPMC_FBAR_TOTAL = 2, /* projects the Jacobian det F (eqs 18-21 in eq 25): no drift in  */
                        /* long quasi-static runs (docs/theory.md)                       */
-  MPMC_FBAR_STABLE = 3 /* the total form projected onto a space one order below the     */
-                       /* basis: no checkerboard of the pressure (docs/theory.md)       */
+  MPMC_FBAR_STABLE = 3, /* the total form projected onto a space one order below the    */
+                        /* basis: no checkerboard of the pressure (docs/theory.md)      */
+  MPMC_FBAR_ANCHORED = 4 /* projects theta det F, theta = Jbar / J re-anchored as a     */
+                         /* point's volume changes: Algorithm 1 in flows, no creep at   */
+                         /* rest (docs/theory.md); the scenes' default                  */
 } mpmc_fbar_mode;
 
 typedef enum {
@@ -166,7 +169,7 @@ int mpmc_sim_get_dim(const mpmc_sim sim, int *dim);
 int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h);
 int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h);
 int mpmc_sim_set_basis(mpmc_sim sim, int basis);
-int mpmc_sim_set_fbar(mpmc_sim sim, int mode); /* mpmc_fbar_mode; 1 = on (paper) */
+int mpmc_sim_set_fbar(mpmc_sim sim, int mode); /* mpmc_fbar_mode (scenes: ANCHORED) */
 int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled);
 int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);

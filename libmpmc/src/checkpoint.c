@@ -279,7 +279,7 @@ static const pfield pfields[] = {PF(x, 0, 1),     PF(x0, 0, 1),     PF(v, 0, 1),
                                  PF(m, 1, 1),     PF(vol0, 1, 1),   PF(J, 1, 1),
                                  PF(stress, 6, 1), PF(Jbar, 1, 0),  PF(be, 6, 0),
                                  PF(eps_p, 1, 0), PF(lp, 1, 0),     PF(force, 0, 0),
-                                 PF(cforce, 0, 0), PF(ustate, -1, 0)};
+                                 PF(cforce, 0, 0), PF(ustate, -1, 0), PF(Janc, 1, 0)};
 #undef PF
 
 static double **pfield_ptr(mpmc_particles *p, const pfield *f) {

@@ -6,19 +6,23 @@
  * j_p = J_p^{n+1} = det F in MPMC_FBAR_TOTAL (eqs 18-21: the projection of the Jacobian
  * itself, inserted in eq 25).  The paper's recursion re-projects Jbar every step, so in a
  * long quasi-static run the smoothing of a non-uniform Jbar near boundaries accumulates
- * into a creep of the true volume (docs/theory.md); the total form has no such memory.
+ * into a creep of the true volume (docs/theory.md); the total form has no such memory but
+ * follows the points' own J, which drifts in large flows.  MPMC_FBAR_ANCHORED, the default,
+ * projects j_p = Janc_p, the point's Jacobian times the Jbar / J it was last anchored to,
+ * re-anchored to Algorithm 1's Jbar^n dJ by the share of the step's volume change (transfer.h,
+ * mpmc_anchor): Algorithm 1 where the points change volume, the total form where they do not.
  * MPMC_FBAR_STABLE projects det F like the total form, but onto a space one order below
  * the basis instead of the basis itself (docs/theory.md, "The J-bar space"): linear hats on
  * the grid of spacing 2h (nodes x = lo, lo + 2h, ...) for linear and uGIMP, linear hats
  * centred on the cells for quadratic B-splines, quadratic B-splines centred on the cells for
  * cubic ones.  With w the weights of that space the formulas above are unchanged.
  * V_p is the volume at t^n.  In a step the scatter runs fused into the transfers, which have
- * the points at x^n and, but in the stable form, the weights at hand: in the paper and total
- * forms P2G adds V_i to the node records (slot MPMC_VSLOT, beside the mass) and G2P (V J)_i to
- * fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P sets
+ * the points at x^n and, but in the stable form, the weights at hand: in the paper, total and
+ * anchored forms P2G adds V_i to the node records (slot MPMC_VSLOT, beside the mass) and G2P
+ * (V J)_i to fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P sets
  * grid.fb_done and keeps what the gather needs of x^n (the points have moved by then): in the
- * paper and total forms the weights, as the basis's offsets and first nodes (xoff, xnode;
- * transfer.h, mpmc_kept_weights4), in the stable form the positions (xn).
+ * paper, total and anchored forms the weights, as the basis's offsets and first nodes (xoff,
+ * xnode; transfer.h, mpmc_kept_weights4), in the stable form the positions (xn).
  * Called on its own (tests) the projection scatters here and gathers, both at x,
  * recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter leaves
  * Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
@@ -40,8 +44,13 @@ MPMC_ALWAYS_INLINE mpmc_v2d scatter_values(mpmc_sim sim, const int DIM, int q) {
   mpmc_particles *p = &sim->p;
   const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
   const double Vn = p->vol0[q] * p->J[q] / dJ;
-  p->Jbar[q] *= dJ;
-  return (mpmc_v2d){Vn, Vn * (sim->fbar == MPMC_FBAR_PAPER ? p->Jbar[q] : p->J[q])};
+  const double jd = p->Jbar[q] * dJ;
+  const double j = sim->fbar == MPMC_FBAR_ANCHORED
+                       ? mpmc_anchor(p, q, dJ, jd)
+                       : sim->fbar == MPMC_FBAR_PAPER ? jd
+                                                      : p->J[q];
+  p->Jbar[q] = jd;
+  return (mpmc_v2d){Vn, Vn * j};
 }
 
 /* Scatter point q: V^n and V^n j onto its nodes (Algorithm 1, step 3), where P2G and G2P
@@ -311,7 +320,7 @@ MPMC_ALWAYS_INLINE double gather_scale1(mpmc_sim sim, const int D, const int B, 
 /* The gather's factors of points q0 .. q1 - 1 at positions xs, or with xs a constant NULL
  * with the weights G2P kept (not in the stable form), into scale[q - q0] (Algorithm 1, step
  * 4): of material id's points (id < 0: of every point; the others' entries and Jbar left
- * alone).  The paper and total forms eight points at a time where they are all
+ * alone).  The paper, total and anchored forms eight points at a time where they are all
  * gathered, else four, then one by one, each lane with the operations of gather_scale; the
  * stable form (ST) four at a time, else one by one (gather_stable_scale): the same bits as
  * point by point. */

@@ -1,11 +1,11 @@
 /* Grid to particle: velocity with the FLIP/PIC blend (eqs 11-13), relative deformation
  * gradient dF = 1 + dt sum v_i (x) grad w (eq 16), J <- J det(dF) so that V = J V0 (eq 15),
  * position (eq 17), in place.  With F-bar the projection's gather, in the material update,
- * still needs the weights at x^n: in the paper and total forms G2P keeps them, as the
+ * still needs the weights at x^n: in the paper, total and anchored forms G2P keeps them, as the
  * offsets from which the basis gives them and the first nodes (xoff, xnode: transfer.h,
  * mpmc_keep_weights), in the stable form, whose space has weights of its own, the old
  * positions (xn).  The projection's scatter (fbar.c) is fused in here, where those weights
- * are at hand (in the paper and total forms only of V^n j: P2G scattered V^n, p2g.c). */
+ * are at hand (in the paper, total and anchored forms only of V^n j: P2G scattered V^n, p2g.c). */
 #include <limits.h>
 #include <math.h>
 
@@ -75,7 +75,9 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
  * (the grid's fbj, one value per node) with the same weights (the points are still at x^n;
  * V^n itself P2G scattered into the records' MPMC_VSLOT); FB = 2 (the stable form): scatter
  * V^n and V^n J into fb (the grid's fb, pairs) with the weights of its own space
- * (transfer.h); either way the caller runs the points in slab colours. */
+ * (transfer.h); either way the caller runs the points in slab colours.  FB + 4 (5, 7): FB's
+ * scatter in the anchored form, j the point's anchored Jacobian (transfer.h, mpmc_anchor),
+ * a kernel of its own so that the other forms do not pay for it. */
 MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, const int FB,
                                  double dt, const g2p_ctx *c, double *restrict fb, int q,
                                  const mpmc_pw4 *t, int l, double *v2max) {
@@ -152,19 +154,23 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   p->J[q] = Jn * dJ;
   int ok = dJ > 0.0 && isfinite(dJ);
   mpmc_v2d vv = {0.0, 0.0};
+  const int FS = FB & 3; /* the scatter's form */
   if (FB) {
     const double Vn = p->vol0[q] * Jn;
     const double jd = p->Jbar[q] * dJ; /* kept for the gather (fbar.c) */
-    vv = (mpmc_v2d){Vn, Vn * (sim->fbar == MPMC_FBAR_PAPER ? jd : p->J[q])};
+    const double j = FB & 4                         ? mpmc_anchor(p, q, dJ, jd)
+                     : sim->fbar == MPMC_FBAR_PAPER ? jd
+                                                    : p->J[q];
+    vv = (mpmc_v2d){Vn, Vn * j};
     p->Jbar[q] = jd;
   }
   const double vj = vv[1];
-  if (FB == 2) {
+  if (FS == 2) {
     mpmc_spw sp;
     mpmc_stable_weights(DIM, BASIS, g, p->x + qd, &sp);
     MPMC_STABLE_LOOP(DIM, BASIS, sp, { MPMC_V2(fb + 2 * node) += w * vv; });
   }
-  if (FB == 1 || FB == 3) fb_scatter(DIM, BASIS, FB == 3, g, fb, W, node0, vj);
+  if (FS == 1 || FS == 3) fb_scatter(DIM, BASIS, FS == 3, g, fb, W, node0, vj);
   if (SPLIT) /* the increment half, factored as above */
     for (int kz = 0; kz < (DIM == 3 ? S : 1); ++kz) {
       mpmc_vd P[MPMC_NV];
@@ -196,7 +202,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     v[a] = va;
     v2 += va * va;
     const double x0 = p->x[qd + a], xa = x0 + dt * vpic[a];
-    if (FB == 2) c->xold[qd + a] = x0;
+    if (FS == 2) c->xold[qd + a] = x0;
     p->x[qd + a] = xa;
     ok &= (xa >= c->xmin[a]) & (xa <= c->xmax[a]);
   }
@@ -264,7 +270,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, double *fbp, int nc, \
                               int *bad, double *vm) {                                         \
     const int *restrict order = sim->order, *restrict start = sim->slab_start;                \
-    const int stable = sim->fbar == MPMC_FBAR_STABLE;                                         \
+    const int stable = sim->fbar == MPMC_FBAR_STABLE, anc = sim->fbar == MPMC_FBAR_ANCHORED;  \
     const mpmc_keep keep = mpmc_keep_of(&sim->p);                                             \
     double *fb0 = stable ? sim->grid.fb : sim->grid.fbj;                                      \
     int first_bad = INT_MAX;                                                                  \
@@ -272,12 +278,19 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     if (fbp) { /* P2G's chunks, each scattering into its own copy (p2g.c) */                  \
       if (stable)                                                                             \
         G2P_CHUNKS(D, B, 2);                                                                  \
+      else if (anc)                                                                           \
+        G2P_CHUNKS(D, B, 5);                                                                  \
       else                                                                                    \
         G2P_CHUNKS(D, B, 1);                                                                  \
     } else if (stable) {                                                                      \
       G2P_SLABS(D, B, 2);                                                                     \
     } else if (sim->slab_axis != 0) { /* rows along x lie within a slab: fb_scatter's WIDE */ \
-      G2P_SLABS(D, B, 3);                                                                     \
+      if (anc)                                                                                \
+        G2P_SLABS(D, B, 7);                                                                   \
+      else                                                                                    \
+        G2P_SLABS(D, B, 3);                                                                   \
+    } else if (anc) {                                                                         \
+      G2P_SLABS(D, B, 5);                                                                     \
     } else {                                                                                  \
       G2P_SLABS(D, B, 1);                                                                     \
     }                                                                                         \

@@ -64,6 +64,8 @@ typedef struct {
   int *mat;      /* [n] material id                                               */
   /* allocated on demand (NULL when the scene does not need them) */
   double *Jbar;  /* [n] det F-bar                (F-bar on)                          */
+  double *Janc;  /* [n] F-bar's anchored form: the anchored Jacobian, J times the point's
+                    last Jbar / J (transfer.h, mpmc_anchor)                          */
   double *be;    /* [n][6] elastic left Cauchy-Green (solid materials)            */
   double *eps_p; /* [n] equivalent plastic strain (plastic materials)             */
   double *lp;    /* [n] uGIMP half-length, fixed at its initial value (uGIMP)      */
@@ -77,7 +79,7 @@ typedef struct {
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
   double *xn;    /* [n][dim] with F-bar's stable form x^n, from G2P (which moves x) to the
                     gather                                                          */
-  double *xoff;  /* [dim][cap] with F-bar's paper and total forms, from G2P to the gather:
+  double *xoff;  /* [dim][cap] with F-bar's paper, total and anchored forms, from G2P to the gather:
                     the points' offsets at x^n from their first stencil nodes (axis a's
                     at xoff + a cap), from which the basis gives their weights          */
   int *xnode;    /* [n] those first stencil nodes (transfer.h, mpmc_kept_weights4)   */
@@ -106,8 +108,8 @@ void mpmc_particles_free(mpmc_particles *p);
  * in whole vectors of 2 or 4 doubles: the halves are mass-momentum and force). */
 #define MPMC_NREC 8
 #define MPMC_FOFF 4
-/* Slot of F-bar's nodal volume sum w V^n (Algorithm 1 step 3) in the paper and total forms:
- * P2G scatters it with the mass (the points are at x^n there as in the projection, and the
+/* Slot of F-bar's nodal volume sum w V^n (Algorithm 1 step 3) in the paper, total and
+ * anchored forms: P2G scatters it with the mass (the points are at x^n there as in the projection, and the
  * slot rides in a vector P2G writes anyway), so G2P's fused scatter adds one value per node,
  * V^n j, instead of two; the grid update leaves the slot alone. */
 #define MPMC_VSLOT 7
@@ -120,12 +122,12 @@ typedef struct {
   int n[3];            /* nodes per axis (1 in unused axes)                         */
   size_t nn;           /* total nodes                                              */
   double *node;        /* [nn][MPMC_NREC] mass, momentum, f_int + f_ext (slots above), with
-                          F-bar's paper and total forms sum w V^n in MPMC_VSLOT; after the
+                          F-bar's paper, total and anchored forms sum w V^n in MPMC_VSLOT; after the
                           grid update mass, new velocity, velocity increment            */
   double *fb;          /* [nn][2] F-bar's stable form only: sum w V, sum w V J in its own
                           space                                                           */
   double *fbj;         /* [nn + 4] F-bar: the nodal Jbar in the active box (fbar.c); in the
-                          paper and total forms G2P scatters sum w V^n j here first, which
+                          paper, total and anchored forms G2P scatters sum w V^n j here first, which
                           the normalisation divides by MPMC_VSLOT's sum in place; the
                           gather loads rows of four from a row's first node, the lanes
                           beyond the stencil unused                                      */

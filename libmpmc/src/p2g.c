@@ -350,7 +350,7 @@ MPMC_ALWAYS_INLINE double rec_slot(const int DIM, int s, double m, const double 
 }
 
 /* Scatter point q: mass, momentum and force w m, w m v, -V sigma grad w + w f_ext, all
- * into the node records, and with F-bar's paper and total forms the volume w V^n into
+ * into the node records, and with F-bar's paper, total and anchored forms the volume w V^n into
  * MPMC_VSLOT (Algorithm 1 step 3's nodal volume, as the products w_x (w_y (w_z V)) that
  * fbar.c's scatter_point repeats; the other terms add exact zeros to the slot).
  * Per row of the stencil the record's increment splits as
@@ -369,7 +369,7 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
   const double *W = &t->w[0][0][l], *DW = &t->dw[0][0][l]; /* node k, axis a: [AX a + 4 k] */
   const double m = p->m[q];
   const double V = p->vol0[q] * p->J[q];
-  const double vf = sim->fbar == MPMC_FBAR_PAPER || sim->fbar == MPMC_FBAR_TOTAL ? V : 0.0;
+  const double vf = sim->fbar != MPMC_FBAR_STABLE ? V : 0.0;
   const double *s = p->stress + (size_t)q * 6;
   /* -V sigma, rows of the (symmetric) stress in the dim-dimensional subspace; being
    * symmetric, row b is also column b */

@@ -190,13 +190,16 @@ int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
 
 /**
  * @brief Choose the F-bar projection: MPMC_FBAR_OFF (0), MPMC_FBAR_PAPER (1, Algorithm 1 as
- * published), MPMC_FBAR_TOTAL (2, the projection of det F) or MPMC_FBAR_STABLE (3, the
- * projection of det F onto a space one order below the basis; docs/theory.md).
+ * published), MPMC_FBAR_TOTAL (2, the projection of det F), MPMC_FBAR_STABLE (3, the
+ * projection of det F onto a space one order below the basis) or MPMC_FBAR_ANCHORED (4, the
+ * scenes' default: Algorithm 1 where the points change volume, at rest where they do not;
+ * docs/theory.md).
  */
 int mpmc_sim_set_fbar(mpmc_sim sim, int mode) {
   if (!sim) return MPMC_ERR_ARG;
-  MPMC_CHECK(mode >= MPMC_FBAR_OFF && mode <= MPMC_FBAR_STABLE, sim->ctx, MPMC_ERR_ARG,
-             "fbar = %d is not one of off (0), paper (1), total (2), stable (3)", mode);
+  MPMC_CHECK(mode >= MPMC_FBAR_OFF && mode <= MPMC_FBAR_ANCHORED, sim->ctx, MPMC_ERR_ARG,
+             "fbar = %d is not one of off (0), paper (1), total (2), stable (3), anchored (4)",
+             mode);
   sim->fbar = mode;
   sim->prepared = 0;
   return MPMC_SUCCESS;
@@ -391,6 +394,15 @@ int mpmc_sim_prepare(mpmc_sim sim) {
   if (sim->fbar && !p->Jbar) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
     for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
+  }
+  /* the anchored form's Jacobian, anchored to the Jbar at hand (J where F-bar starts with
+   * the run); the other forms derive nothing from it: freed */
+  if (sim->fbar == MPMC_FBAR_ANCHORED && !p->Janc) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Janc, 1, 1.0));
+    memcpy(p->Janc, p->Jbar, sizeof(double) * (size_t)p->n);
+  } else if (sim->fbar != MPMC_FBAR_ANCHORED) {
+    free(p->Janc);
+    p->Janc = NULL;
   }
   /* x^n for the gather (fbar.c): as positions for the stable form, as the weights' offsets
    * and first nodes for the others (transfer.h, mpmc_kept_weights4); what the form does not

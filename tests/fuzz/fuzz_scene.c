@@ -56,7 +56,7 @@ static void check_scene(const wf_scene *sc) {
     require(sc->h <= sc->hi[a] - sc->lo[a], "cell_size <= grid extent", sc);
   }
   require(sc->basis >= 0 && sc->basis <= 3, "basis", sc);
-  require(sc->fbar >= 0 && sc->fbar <= 2, "fbar", sc);
+  require(sc->fbar >= MPMC_FBAR_OFF && sc->fbar <= MPMC_FBAR_ANCHORED, "fbar", sc);
   require(sc->flip >= 0 && sc->flip <= 1, "flip in [0, 1]", sc);
   require(sc->threads >= 0, "threads >= 0", sc);
   require(sc->checkpoint_interval > 0 && sc->progress_interval > 0, "intervals > 0", sc);
