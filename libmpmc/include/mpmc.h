@@ -70,9 +70,9 @@ typedef enum {
                        /* long quasi-static runs (docs/theory.md)                       */
   MPMC_FBAR_STABLE = 3, /* the total form projected onto a space one order below the    */
                         /* basis: no checkerboard of the pressure (docs/theory.md)      */
-  MPMC_FBAR_ANCHORED = 4 /* projects theta det F, theta = Jbar / J re-anchored as a     */
-                         /* point's volume changes: Algorithm 1 in flows, no creep at   */
-                         /* rest (docs/theory.md); the scenes' default                  */
+  MPMC_FBAR_ANCHORED = 4 /* projects theta det F, theta = Jbar / J re-anchored as a   */
+                         /* point changes volume or moves: Algorithm 1 in flows, no */
+                         /* creep at rest (docs/theory.md); the scenes' default     */
 } mpmc_fbar_mode;
 
 typedef enum {

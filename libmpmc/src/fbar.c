@@ -9,8 +9,9 @@
  * into a creep of the true volume (docs/theory.md); the total form has no such memory but
  * follows the points' own J, which drifts in large flows.  MPMC_FBAR_ANCHORED, the default,
  * projects j_p = Janc_p, the point's Jacobian times the Jbar / J it was last anchored to,
- * re-anchored to Algorithm 1's Jbar^n dJ by the share of the step's volume change (transfer.h,
- * mpmc_anchor): Algorithm 1 where the points change volume, the total form where they do not.
+ * re-anchored to Algorithm 1's Jbar^n dJ by the share of the step's volume change and travel
+ * (transfer.h, mpmc_anchor): Algorithm 1 where the points change volume or move, the total
+ * form where they rest.
  * MPMC_FBAR_STABLE projects det F like the total form, but onto a space one order below
  * the basis instead of the basis itself (docs/theory.md, "The J-bar space"): linear hats on
  * the grid of spacing 2h (nodes x = lo, lo + 2h, ...) for linear and uGIMP, linear hats
@@ -46,7 +47,7 @@ MPMC_ALWAYS_INLINE mpmc_v2d scatter_values(mpmc_sim sim, const int DIM, int q) {
   const double Vn = p->vol0[q] * p->J[q] / dJ;
   const double jd = p->Jbar[q] * dJ;
   const double j = sim->fbar == MPMC_FBAR_ANCHORED
-                       ? mpmc_anchor(p, q, dJ, jd)
+                       ? mpmc_anchor(p, q, dJ, jd, INFINITY) /* no step: Algorithm 1's */
                        : sim->fbar == MPMC_FBAR_PAPER ? jd
                                                       : p->J[q];
   p->Jbar[q] = jd;

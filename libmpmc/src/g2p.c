@@ -92,6 +92,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
    * 16 SSE registers: the first sweep then takes the velocity half (v_pic, L) and the second
    * the increment half (dv).  The fused F-bar scatter, which needs dJ, has a loop of its own. */
   const int SPLIT = NC > 1, N1 = SPLIT ? NC : NV;
+  const double travel = FB & 4 ? mpmc_anchor_travel(DIM, p, q, dt * g->inv_h) : 0.0;
   mpmc_vd A[MPMC_NV], B0[MPMC_NC], B1[MPMC_NC], B2[MPMC_NC];
   for (int k = 0; k < NV; ++k) A[k] = zero;
   for (int k = 0; k < NC; ++k) B0[k] = B1[k] = B2[k] = zero;
@@ -158,7 +159,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   if (FB) {
     const double Vn = p->vol0[q] * Jn;
     const double jd = p->Jbar[q] * dJ; /* kept for the gather (fbar.c) */
-    const double j = FB & 4                         ? mpmc_anchor(p, q, dJ, jd)
+    const double j = FB & 4                         ? mpmc_anchor(p, q, dJ, jd, travel)
                      : sim->fbar == MPMC_FBAR_PAPER ? jd
                                                     : p->J[q];
     vv = (mpmc_v2d){Vn, Vn * j};

@@ -192,7 +192,7 @@ int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
  * @brief Choose the F-bar projection: MPMC_FBAR_OFF (0), MPMC_FBAR_PAPER (1, Algorithm 1 as
  * published), MPMC_FBAR_TOTAL (2, the projection of det F), MPMC_FBAR_STABLE (3, the
  * projection of det F onto a space one order below the basis) or MPMC_FBAR_ANCHORED (4, the
- * scenes' default: Algorithm 1 where the points change volume, at rest where they do not;
+ * scenes' default: Algorithm 1 where the points change volume or move, still where they rest;
  * docs/theory.md).
  */
 int mpmc_sim_set_fbar(mpmc_sim sim, int mode) {

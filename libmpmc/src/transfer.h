@@ -209,24 +209,37 @@ MPMC_ALWAYS_INLINE double mpmc_det_dim(const int DIM, const double *F) {
 
 /* ---- the J-bar space of the stable form of F-bar (fbar.c, fused into g2p.c) ---------- */
 /* Nodes per axis in a point's support in the J-bar space of the stable form. */
-/* The volume strain over which F-bar's anchored form re-anchors a point (docs/theory.md):
- * the share alpha = |dJ - 1| / MPMC_ANCHOR_STRAIN of the way (at most all of it) per step, so
- * by the change of volume the point undergoes, not by the number of steps: what drifts in a
- * flow is the points' J, and a point whose J does not change keeps its anchor.  1e-2: the
- * self-weight column settles within 0.03 % of the total form's settlement, the dam break's
- * centre of mass stays within 0.1 % of Algorithm 1's (docs/theory.md). */
+/* How fast F-bar's anchored form re-anchors a point (docs/theory.md): the share
+ * alpha = (|dJ - 1| + |v^n|_1 dt / h) / MPMC_ANCHOR_STRAIN of the way per step (at most all of
+ * it), by the change of volume the point undergoes and the cells it travels, not by the number
+ * of steps: what drifts in a flow is the points' J, as they change volume and cross cells, and
+ * a point that does neither keeps its anchor.  1e-2: the self-weight column settles within
+ * 0.03 % of the total form's settlement; the dam break and the landslides follow Algorithm 1
+ * (docs/theory.md). */
 #define MPMC_ANCHOR_STRAIN 1e-2
+
+/* The travel term of the anchored form's share, |v^n|_1 dt / h, for point q (its velocity
+ * before G2P updates it, the sum of its components' magnitudes: a square root a point cost
+ * G2P 4 %); read ahead of the gather, off the scatter's path. */
+MPMC_ALWAYS_INLINE double mpmc_anchor_travel(const int DIM, const mpmc_particles *p, int q,
+                                             double dt_over_h) {
+  const double *v = p->v + (size_t)q * DIM;
+  double s = fabs(v[0]) + fabs(v[1]);
+  if (DIM == 3) s += fabs(v[2]);
+  return s * dt_over_h;
+}
 
 /* F-bar's anchored form (fbar.c): point q's anchored Jacobian Janc (J times the Jbar / J it
  * was last anchored to) carried by this step's dJ and re-anchored to Algorithm 1's
- * jd = Jbar^n dJ by the share alpha of the step's volume change:
+ * jd = Jbar^n dJ by the share alpha of the step (travel: mpmc_anchor_travel):
  * Janc <- Janc dJ + alpha (jd - Janc dJ).  alpha = 1 is Algorithm 1 (it projects jd),
  * alpha = 0 the projection of J calibrated by the point's last anchoring.  Returns Janc, the
- * value the point scatters.  (The magnitude of the whole strain increment instead of dJ's
+ * value the point scatters.  (The magnitude of the whole strain increment in place of dJ's
  * cost G2P a quarter more: its sum stood between the point's gather and its scatter.) */
-MPMC_ALWAYS_INLINE double mpmc_anchor(mpmc_particles *p, int q, double dJ, double jd) {
-  const double r = fabs(dJ - 1.0) * (1.0 / MPMC_ANCHOR_STRAIN), alpha = r < 1.0 ? r : 1.0;
-  const double carried = p->Janc[q] * dJ;
+MPMC_ALWAYS_INLINE double mpmc_anchor(mpmc_particles *p, int q, double dJ, double jd,
+                                      double travel) {
+  const double r = (fabs(dJ - 1.0) + travel) * (1.0 / MPMC_ANCHOR_STRAIN);
+  const double alpha = r < 1.0 ? r : 1.0, carried = p->Janc[q] * dJ;
   return p->Janc[q] = carried + alpha * (jd - carried);
 }
 
