@@ -1,4 +1,4 @@
-/* Context and errors (STYLE.md): every code has its message from the X-macro, the last error
+/* Context and errors: every code has its message from the X-macro, the last error
  * names the failure, destroy accepts NULL and clears the handle, the log level is checked. */
 #include <setjmp.h>
 #include <stdarg.h>

@@ -103,7 +103,8 @@ static void test_known_values(void **state) {
   TCLOSE(w[0], 0.0625, 1e-15); /* (1 + l - 1)^2/(4 l) = l/4 */
 }
 
-/* formulas.md's uGIMP weight in its four pieces (cell units: distance x, half-length l) */
+/* The uGIMP weight (Bardenhagen & Kober 2004) in its four pieces (cell units: distance x,
+ * half-length l) */
 static double ugimp_ref(double x, double l) {
   const double a = fabs(x);
   if (a >= 1.0 + l) return 0.0;
@@ -133,7 +134,7 @@ static void test_ugimp_reference(void **state) {
     for (int k = 0; k < 3; ++k) {
       const double ref = ugimp_ref(s - (base + k), l);
       if (!(fabs(w[k] - ref) <= 1e-7 * ref + 1e-300 && fabs(w[k] - ref) <= 1e-14))
-        fail_msg("uGIMP s = %.17g, l = %.17g, node %d: w = %.17g, formulas.md %.17g", s, l, k, w[k], ref);
+        fail_msg("uGIMP s = %.17g, l = %.17g, node %d: w = %.17g, reference %.17g", s, l, k, w[k], ref);
     }
     if (w[3] != 0.0 || dw[3] != 0.0) fail_msg("uGIMP: the fourth lane is %g, %g (expected 0)", w[3], dw[3]);
   }

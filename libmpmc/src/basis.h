@@ -1,5 +1,5 @@
-/* Basis functions (formulas.md): 1D weights and gradients, tensor products in 2D/3D.
- * Inline so that the transfer kernels, instantiated per (dim, basis) with compile-time
+/* Basis functions (Bardenhagen & Kober 2004; Steffen et al. 2008): 1D weights and
+ * gradients, tensor products in 2D/3D.  Inline so that the transfer kernels, instantiated per (dim, basis) with compile-time
  * constants, fold the basis switch away. */
 #ifndef MPMC_BASIS_H
 #define MPMC_BASIS_H
@@ -47,10 +47,10 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
  * (y in [-1/2, 1/2)) and c = y clamped to [-l, l]:
  *   w0 = (l - c)^2 / 4l + max(0, -l - y),   w2 = (l + c)^2 / 4l + max(0, y - l),
  *   w1 = 1 - (c^2 + l^2) / 2l - |y - c|,    w' = (c - l, -2c, c + l) / 2l
- * which are formulas.md's pieces in each of the three ranges of y (the point's support
- * overlapping the middle node's kink, or not, on either side), without branches.  A tail
- * weight near the support's end keeps its relative accuracy (l - c and l + c are exact
- * there), which matters: a node reached only by such a tail divides a force ~ w' by a mass
+ * which are the uGIMP weight's pieces (Bardenhagen & Kober 2004) in each of the three
+ * ranges of y (the point's support overlapping the middle node's kink, or not, on either
+ * side), without branches.  A tail weight near the support's end keeps its relative
+ * accuracy (l - c and l + c are exact there), which matters: a node reached only by such a tail divides a force ~ w' by a mass
  * ~ w; a difference of the hat's antiderivative, whose absolute rounding error is 1e-17,
  * inverted a point of the 2D Cook membrane (t201 checks the tails).  Nodes outside the
  * support get exactly 0. */

@@ -1,6 +1,6 @@
 /* Rigid bodies (axis-aligned boxes in 2D/3D, simple polygons in 2D) moved with a prescribed
  * velocity, in contact with the material points through the IPC barrier (Li et al. 2020;
- * Zhao et al. 2022; formulas.md):
+ * Zhao et al. 2022):
  *
  *   E_p = A_p kappa b(d),  b(d) = -(d - dhat)^2 ln(d/dhat) for 0 < d < dhat, else 0,
  *   f_p = -dE_p/dx_p = A_p kappa (d - dhat) [2 ln(d/dhat) + 1 - dhat/d] n = A_p kappa dhat g(d/dhat) n
@@ -207,7 +207,7 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
         if (u) u[0] = NAN;
         continue;
       }
-      /* normal force (paper's barrier, formulas.md) */
+      /* normal force (the paper's barrier, -b'(d)) */
       const double lam = point_area(d, p->vol0[q]) * kappa * dhat * barrier_g(gap / dhat);
       double f[3] = {0, 0, 0};
       for (int a = 0; a < d; ++a) f[a] = lam * n[a];

@@ -1,6 +1,6 @@
 /* Hencky elasticity with von Mises (J2) plasticity and exponential softening, return
- * mapping in principal logarithmic strain space (formulas.md, "Hencky-J2"; the paper's
- * footing and landslide models):
+ * mapping in principal logarithmic strain space (de Souza Neto et al. 2008, ch. 14; the
+ * paper's footing and landslide models):
  *   trial  b_e = dF b_e^n dF^T  (dF-bar with F-bar on), b_e = sum lam_a n_a n_a^T,
  *          eps_a = 1/2 ln lam_a,  tau_a = K tr(eps) + 2G dev(eps)_a,
  *   yield  q = sqrt(3/2) |dev tau| <= kappa(eps_p) = kappa_r + (kappa_p - kappa_r) e^(-eta eps_p),

@@ -214,7 +214,7 @@ typedef enum {
 struct mpmc_sim_s;
 typedef struct mpmc_material_s mpmc_material;
 
-/* The material table (STYLE.md): one file per model. */
+/* The material table: one file per model. */
 typedef struct {
   const char *name;
   /* Update the stress of every point p with mat[p] == id from the relative deformation

@@ -1,8 +1,8 @@
 /* Return mapping for Hencky elasticity with von Mises (J2) plasticity and exponential
  * softening (private; used by material_hencky_j2.c, the tests and bench/).
  *
- * The scalar problem (formulas.md, "Hencky-J2"): after a trial state with von Mises stress
- * q_trial > kappa(eps_p), find the plastic multiplier dgamma > 0 with
+ * The scalar problem (de Souza Neto et al. 2008, box 7.4): after a trial state with von
+ * Mises stress q_trial > kappa(eps_p), find the plastic multiplier dgamma > 0 with
  *   g(dgamma) = q_trial - 3 G dgamma - kappa(eps_p + dgamma) = 0,
  *   kappa(e)  = kappa_r + (kappa_p - kappa_r) exp(-eta e).
  * g is concave (kappa'' > 0), g(0) > 0 and g -> -inf, so the root is unique and lies in

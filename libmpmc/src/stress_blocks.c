@@ -6,7 +6,7 @@
  *   Hencky       b <- dF b dF^T,  eps = 1/2 ln b,  J = sqrt(det b),
  *                sigma = (K tr eps 1 + 2G dev eps) / J;
  *   Newtonian    sigma = K (J - 1) 1 + 2 mu dev(D),  D = sym(dF - 1) / dt, J the F-bar
- *                Jacobian when F-bar is on (formulas.md).
+ *                Jacobian when F-bar is on (the paper, section 4.3).
  * Four points of the material in a row (points 4k .. 4k + 3) go through them as vectors of
  * four doubles, lanes the points, with the operations of the point-by-point form in the same
  * order (batch4.h), so the same bits as one point alone in a set without contraction
