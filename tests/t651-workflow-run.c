@@ -40,13 +40,7 @@ static const char *scene_text =
     "  tip_displacement_y: {point: [0.5, 1.0]}\n"
     "  center_of_mass_x:\n";
 
-static void write_text(const char *path, const char *text) {
-  mkdir(DIR, 0777);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
+static void write_text(const char *path, const char *text) { test_write_text(DIR, path, text); }
 
 static void write_scene(const char *path) { write_text(path, scene_text); }
 

@@ -59,13 +59,7 @@ static const char *scene_text =
     "metrics:\n"
     "  runout_distance: {axis: x}\n";
 
-static void write_text(const char *path, const char *text) {
-  mkdir(DIR, 0777);
-  FILE *f = fopen(path, "w");
-  assert_non_null(f);
-  fputs(text, f);
-  fclose(f);
-}
+static void write_text(const char *path, const char *text) { test_write_text(DIR, path, text); }
 
 /* `mpmc` with arguments (NULL-terminated), output to DIR/cli.log; the child's pid. */
 static pid_t spawn_cli(const char *a0, ...) {

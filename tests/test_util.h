@@ -87,6 +87,15 @@ static inline int test_exists(const char *path) {
 }
 
 /* The whole of a file, NUL-terminated, malloc'ed (free it); fails the test if unreadable. */
+/* Write text to path, creating its folder dir (one level) first. */
+static inline void test_write_text(const char *dir, const char *path, const char *text) {
+  mkdir(dir, 0777);
+  FILE *f = fopen(path, "w");
+  if (!f) fail_msg("expected to write %s, cannot open it", path);
+  fputs(text, f);
+  fclose(f);
+}
+
 static inline char *test_slurp(const char *path) {
   FILE *f = fopen(path, "rb");
   if (!f) fail_msg("expected to read %s, cannot open it", path);
