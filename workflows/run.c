@@ -328,7 +328,7 @@ static int stage_setup(wf_run *w, int i) {
   mpmc_sim sim = w->sim;
   if (s->has_gravity) WF_TRY(w, mpmc_sim_set_gravity(sim, s->gravity), "stages.%d.gravity", i);
   WF_TRY(w, mpmc_sim_set_damping(sim, s->damping), "stages.%d.damping", i);
-  WF_TRY(w, mpmc_sim_set_flip_blend(sim, s->flip >= 0 ? s->flip : sc->flip), "stages.%d.flip", i);
+  WF_TRY(w, mpmc_sim_set_flip_blend(sim, s->flip), "stages.%d.flip", i);
   WF_TRY(w, mpmc_sim_set_force_dt(sim, s->force_dt), "stages.%d.force_dt", i);
   int base = 0;
   for (int j = 0; j < i; ++j) base += sc->stages[j].nwalls;
@@ -904,7 +904,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
       if (setup) {
         const wf_stage *s = &w.sc.stages[stage];
         mpmc_sim_set_damping(w.sim, s->damping);
-        mpmc_sim_set_flip_blend(w.sim, s->flip >= 0 ? s->flip : w.sc.flip);
+        mpmc_sim_set_flip_blend(w.sim, s->flip);
       }
       err = run_all(&w, stage, &clock, steps, setup) ? ctx->last_code : 0;
     }

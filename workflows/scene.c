@@ -941,7 +941,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     if (get_num(r, n, p, "damping", 0, 0, damp, &s->damping)) return -1;
     /* absent: the scene's blend (a quasi-static stage of a FLIP scene takes a little PIC:
      * docs/theory.md) */
-    if (get_num(r, n, p, "flip", 0, -1.0, UNIT, &s->flip)) return -1;
+    if (get_num(r, n, p, "flip", 0, sc->flip, UNIT, &s->flip)) return -1;
     const range srf = {0, INFINITY, 1, 0};
     /* 0: unchanged from the previous stage */
     if (get_num(r, n, p, "strength_reduction", 0, 0.0, srf, &s->strength_reduction)) return -1;

@@ -100,7 +100,7 @@ typedef struct {
   int has_gravity;
   double gravity[3];
   double damping;
-  double flip; /* the stage's FLIP/PIC blend; < 0: the scene's */
+  double flip; /* the stage's FLIP/PIC blend (the scene's where the stage sets none) */
   int nwalls;
   wf_wall *walls;
   int nremove;

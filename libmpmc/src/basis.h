@@ -1,6 +1,6 @@
 /* Basis functions (Bardenhagen & Kober 2004; Steffen et al. 2008): 1D weights and
- * gradients, tensor products in 2D/3D.  Inline so that the transfer kernels, instantiated per (dim, basis) with compile-time
- * constants, fold the basis switch away. */
+ * gradients, tensor products in 2D/3D.  Inline so that the transfer kernels, instantiated
+ * per (dim, basis) with compile-time constants, fold the basis switch away. */
 #ifndef MPMC_BASIS_H
 #define MPMC_BASIS_H
 
@@ -50,10 +50,10 @@ MPMC_ALWAYS_INLINE int mpmc_stencil(int basis) {
  * which are the uGIMP weight's pieces (Bardenhagen & Kober 2004) in each of the three
  * ranges of y (the point's support overlapping the middle node's kink, or not, on either
  * side), without branches.  A tail weight near the support's end keeps its relative
- * accuracy (l - c and l + c are exact there), which matters: a node reached only by such a tail divides a force ~ w' by a mass
- * ~ w; a difference of the hat's antiderivative, whose absolute rounding error is 1e-17,
- * inverted a point of the 2D Cook membrane (t201 checks the tails).  Nodes outside the
- * support get exactly 0. */
+ * accuracy (l - c and l + c are exact there), which matters: a node reached only by such a
+ * tail divides a force ~ w' by a mass ~ w; a difference of the hat's antiderivative, whose
+ * absolute rounding error is 1e-17, inverted a point of the 2D Cook membrane (t201 checks
+ * the tails).  Nodes outside the support get exactly 0. */
 typedef double mpmc_b4d __attribute__((vector_size(4 * sizeof(double))));
 typedef long long mpmc_b4l __attribute__((vector_size(4 * sizeof(long long))));
 typedef int mpmc_b4i __attribute__((vector_size(4 * sizeof(int))));

@@ -20,8 +20,8 @@
  * V_p is the volume at t^n.  In a step the scatter runs fused into the transfers, which have
  * the points at x^n and, but in the stable form, the weights at hand: in the paper, total and
  * anchored forms P2G adds V_i to the node records (slot MPMC_VSLOT, beside the mass) and G2P
- * (V J)_i to fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P sets
- * grid.fb_done and keeps what the gather needs of x^n (the points have moved by then): in the
+ * (V J)_i to fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P
+ * sets grid.fb_done and keeps what the gather needs of x^n (the points have moved by then): in the
  * paper, total and anchored forms the weights, as the basis's offsets and first nodes (xoff,
  * xnode; transfer.h, mpmc_kept_weights4), in the stable form the positions (xn).
  * Called on its own (tests) the projection scatters here and gathers, both at x,
@@ -46,10 +46,8 @@ MPMC_ALWAYS_INLINE mpmc_v2d scatter_values(mpmc_sim sim, const int DIM, int q) {
   const double dJ = mpmc_det_dim(DIM, p->dF + (size_t)q * DIM * DIM);
   const double Vn = p->vol0[q] * p->J[q] / dJ;
   const double jd = p->Jbar[q] * dJ;
-  const double j = sim->fbar == MPMC_FBAR_ANCHORED
-                       ? mpmc_anchor(p, q, dJ, jd, INFINITY) /* no step: Algorithm 1's */
-                       : sim->fbar == MPMC_FBAR_PAPER ? jd
-                                                      : p->J[q];
+  /* no step to measure the travel: the anchored form re-anchors fully (Algorithm 1's) */
+  const double j = mpmc_fbar_j(sim->fbar == MPMC_FBAR_ANCHORED, sim->fbar, p, q, dJ, jd, INFINITY);
   p->Jbar[q] = jd;
   return (mpmc_v2d){Vn, Vn * j};
 }

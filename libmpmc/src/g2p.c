@@ -1,11 +1,12 @@
 /* Grid to particle: velocity with the FLIP/PIC blend (eqs 11-13), relative deformation
  * gradient dF = 1 + dt sum v_i (x) grad w (eq 16), J <- J det(dF) so that V = J V0 (eq 15),
  * position (eq 17), in place.  With F-bar the projection's gather, in the material update,
- * still needs the weights at x^n: in the paper, total and anchored forms G2P keeps them, as the
- * offsets from which the basis gives them and the first nodes (xoff, xnode: transfer.h,
+ * still needs the weights at x^n: in the paper, total and anchored forms G2P keeps them, as
+ * the offsets from which the basis gives them and the first nodes (xoff, xnode: transfer.h,
  * mpmc_keep_weights), in the stable form, whose space has weights of its own, the old
  * positions (xn).  The projection's scatter (fbar.c) is fused in here, where those weights
- * are at hand (in the paper, total and anchored forms only of V^n j: P2G scattered V^n, p2g.c). */
+ * are at hand (in the paper, total and anchored forms only of V^n j: P2G scattered V^n,
+ * p2g.c). */
 #include <limits.h>
 #include <math.h>
 
@@ -159,10 +160,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   if (FB) {
     const double Vn = p->vol0[q] * Jn;
     const double jd = p->Jbar[q] * dJ; /* kept for the gather (fbar.c) */
-    const double j = FB & 4                         ? mpmc_anchor(p, q, dJ, jd, travel)
-                     : sim->fbar == MPMC_FBAR_PAPER ? jd
-                                                    : p->J[q];
-    vv = (mpmc_v2d){Vn, Vn * j};
+    vv = (mpmc_v2d){Vn, Vn * mpmc_fbar_j(FB & 4, sim->fbar, p, q, dJ, jd, travel)};
     p->Jbar[q] = jd;
   }
   const double vj = vv[1];

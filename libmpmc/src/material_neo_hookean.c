@@ -1,4 +1,5 @@
-/* Compressible Neo-Hookean (the paper, section 4.1): psi = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,
+/* Compressible Neo-Hookean (the paper, section 4.1):
+ * psi = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,
  * Kirchhoff stress tau = mu (b - 1) + lambda ln J 1, with b = Fbar Fbar^T carried
  * incrementally as b <- dF b dF^T (plane strain: b_zz stays 1). */
 #include <math.h>

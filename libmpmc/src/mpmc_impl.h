@@ -109,9 +109,9 @@ void mpmc_particles_free(mpmc_particles *p);
 #define MPMC_NREC 8
 #define MPMC_FOFF 4
 /* Slot of F-bar's nodal volume sum w V^n (Algorithm 1 step 3) in the paper, total and
- * anchored forms: P2G scatters it with the mass (the points are at x^n there as in the projection, and the
- * slot rides in a vector P2G writes anyway), so G2P's fused scatter adds one value per node,
- * V^n j, instead of two; the grid update leaves the slot alone. */
+ * anchored forms: P2G scatters it with the mass (the points are at x^n there as in the
+ * projection, and the slot rides in a vector P2G writes anyway), so G2P's fused scatter adds
+ * one value per node, V^n j, instead of two; the grid update leaves the slot alone. */
 #define MPMC_VSLOT 7
 _Static_assert(MPMC_VSLOT >= MPMC_FOFF + 3 && MPMC_VSLOT < MPMC_NREC, "a free record slot");
 typedef struct {

@@ -350,8 +350,8 @@ MPMC_ALWAYS_INLINE double rec_slot(const int DIM, int s, double m, const double 
 }
 
 /* Scatter point q: mass, momentum and force w m, w m v, -V sigma grad w + w f_ext, all
- * into the node records, and with F-bar's paper, total and anchored forms the volume w V^n into
- * MPMC_VSLOT (Algorithm 1 step 3's nodal volume, as the products w_x (w_y (w_z V)) that
+ * into the node records, and with F-bar's paper, total and anchored forms the volume w V^n
+ * into MPMC_VSLOT (Algorithm 1 step 3's nodal volume, as the products w_x (w_y (w_z V)) that
  * fbar.c's scatter_point repeats; the other terms add exact zeros to the slot).
  * Per row of the stencil the record's increment splits as
  *   rec += w_x c + w_x' e,  c = w_y (w_z (m, m v, f_ext, V) + w_z' (-V sigma_.2))

@@ -207,14 +207,12 @@ MPMC_ALWAYS_INLINE double mpmc_det_dim(const int DIM, const double *F) {
                         F[2] * (F[3] * F[7] - F[4] * F[6]);
 }
 
-/* ---- the J-bar space of the stable form of F-bar (fbar.c, fused into g2p.c) ---------- */
-/* Nodes per axis in a point's support in the J-bar space of the stable form. */
 /* How fast F-bar's anchored form re-anchors a point (docs/theory.md): the share
  * alpha = (|dJ - 1| + |v^n|_1 dt / h) / MPMC_ANCHOR_STRAIN of the way per step (at most all of
  * it), by the change of volume the point undergoes and the cells it travels, not by the number
  * of steps: what drifts in a flow is the points' J, as they change volume and cross cells, and
  * a point that does neither keeps its anchor.  1e-2: the self-weight column settles within
- * 0.03 % of the total form's settlement; the dam break and the landslides follow Algorithm 1
+ * 0.1 % of the total form's settlement; the dam break and the landslides follow Algorithm 1
  * (docs/theory.md). */
 #define MPMC_ANCHOR_STRAIN 1e-2
 
@@ -243,6 +241,16 @@ MPMC_ALWAYS_INLINE double mpmc_anchor(mpmc_particles *p, int q, double dJ, doubl
   return p->Janc[q] = carried + alpha * (jd - carried);
 }
 
+/* What point q scatters as V^n j in the forms that project onto the basis: ANC (the anchored
+ * form, a constant in G2P's kernels) its anchored Jacobian, else Jbar^n dJ = jd in Algorithm 1
+ * (MPMC_FBAR_PAPER) or J^{n+1} in the total form. */
+MPMC_ALWAYS_INLINE double mpmc_fbar_j(const int ANC, int fbar, mpmc_particles *p, int q,
+                                      double dJ, double jd, double travel) {
+  return ANC ? mpmc_anchor(p, q, dJ, jd, travel) : fbar == MPMC_FBAR_PAPER ? jd : p->J[q];
+}
+
+/* ---- the J-bar space of the stable form of F-bar (fbar.c, fused into g2p.c) ---------- */
+/* Nodes per axis in a point's support in the J-bar space of the stable form. */
 MPMC_ALWAYS_INLINE int mpmc_stable_stencil(const int BASIS) { return BASIS == MPMC_BASIS_BSPLINE3 ? 3 : 2; }
 
 /* The stable form's space along one axis.  Linear, uGIMP: hats of spacing 2h on the grid
