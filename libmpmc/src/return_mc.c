@@ -1,0 +1,825 @@
+/* The frictional return map (return_mc.h): Mohr-Coulomb and Drucker-Prager with a tension
+ * cut-off, in principal Kirchhoff stress space (de Souza Neto, Peric & Owen 2008, sections
+ * 8.2-8.3 for the multi-surface return; ch. 14 for the logarithmic-strain setting).
+ *
+ * One region = a set of n active surfaces.  The unknowns are y = (dgamma_1..dgamma_n, D),
+ * D the increment of eps_p; the residuals, with every material parameter at eps_p^n + D,
+ *   R_i = f_i(s),  s = s_trial - De sum_j dgamma_j N_j        (i < n; N_j = dg_j/ds)
+ *   R_n = D - sqrt(2/3) |dev sum_j dgamma_j N_j|
+ * For the planes of Mohr-Coulomb and of the cut-off, f_i is linear in s: with the parameters
+ * frozen (perfect plasticity) the multipliers are one n x n linear solve.  Drucker-Prager's
+ * cone is not a plane, but its return is radial in the deviator: with the cut-off's
+ * multipliers fixed, s' = s_x (1 - G dgamma_D / sqrt(J2(s_x))) and p = p_x - K etab dgamma_D
+ * (s_x, p_x: the trial less the cut-off's correction), so its residuals stay explicit. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <kinsol/kinsol.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include "linalg.h"
+#include "return_mc.h"
+
+#define MC_MAX_ITERS 60
+#define MC_NMAX 4 /* unknowns: <= 3 multipliers and D */
+
+/* surfaces in the sorted principal space s1 >= s2 >= s3 */
+enum { S_A = 0, S_B, S_C, S_T1, S_T2, S_T3, S_DP };
+/* Mohr-Coulomb planes (s_I - s_J) + (s_I + s_J) sin(phi) = 2 c cos(phi): A main (1-3),
+ * B compression edge partner (2-3), C extension edge partner (1-2) */
+static const int mc_ij[3][2] = {{0, 2}, {1, 2}, {0, 1}};
+
+/* the material at eps_p and the derivatives in eps_p */
+typedef struct {
+  double c, sf, cf, ss, cs;     /* c, sin/cos phi, sin/cos psi     */
+  double dc, dphi, dsf, dcf, dss; /* d/d eps_p                       */
+  double eta, xi, etab;         /* Drucker-Prager: eta_f(phi), xi(phi), eta_f(psi) */
+  double deta, dxi, detab;
+  double st, dst;               /* cut-off, capped at the apex     */
+  int st_apex;                  /* 1 when the cap (the apex) is the cut-off */
+} mc_mat;
+
+/* One region's problem. */
+typedef struct {
+  const mpmc_mc_param *m;
+  int dp, n, act[3];
+  double str[3];  /* sorted trial stress                                  */
+  double ep0;     /* eps_p^n                                              */
+  int frozen;     /* parameters fixed at x_r + (x_p - x_r) e_frozen         */
+  double e_frozen;
+  double tolf;    /* tolerance on f [Pa]                                  */
+  double yscale;  /* typical size of a multiplier (strain)                */
+} mc_sys;
+
+/* Drucker-Prager's eta_f, xi of one matching at phi and their phi-derivatives. */
+static void dp_coef(int surface, double phi, double *eta, double *xi, double *deta,
+                    double *dxi) {
+  const double s = sin(phi), c = cos(phi), r3 = sqrt(3.0);
+  if (surface == MPMC_DP_PLANE_STRAIN) {
+    const double t = tan(phi), w = 9.0 + 12.0 * t * t, sw = sqrt(w), dt = 1.0 / (c * c);
+    *eta = 3.0 * t / sw;
+    *xi = 3.0 / sw;
+    *deta = 27.0 / (w * sw) * dt;
+    *dxi = -36.0 * t / (w * sw) * dt;
+    return;
+  }
+  const double g = surface == MPMC_DP_COMPRESSION ? 3.0 - s : 3.0 + s;
+  const double dg = surface == MPMC_DP_COMPRESSION ? -c : c; /* dg/dphi */
+  *eta = 6.0 * s / (r3 * g);
+  *xi = 6.0 * c / (r3 * g);
+  *deta = 6.0 / r3 * (c * g - s * dg) / (g * g);
+  *dxi = 6.0 / r3 * (-s * g - c * dg) / (g * g);
+}
+
+/* x(eps_p) = x_r + (x_p - x_r) e with e = exp(-eta eps_p); derivative -eta (x_p - x_r) e */
+static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q) {
+  const double de = frozen ? 0.0 : -m->eta * e; /* de/d eps_p */
+  const double phi = m->phi_r + (m->phi_p - m->phi_r) * e;
+  const double psi = m->psi_r + (m->psi_p - m->psi_r) * e;
+  q->c = m->c_r + (m->c_p - m->c_r) * e;
+  q->dc = (m->c_p - m->c_r) * de;
+  q->dphi = (m->phi_p - m->phi_r) * de;
+  const double dpsi = (m->psi_p - m->psi_r) * de;
+  q->sf = sin(phi);
+  q->cf = cos(phi);
+  q->ss = sin(psi);
+  q->cs = cos(psi);
+  q->dsf = q->cf * q->dphi;
+  q->dcf = -q->sf * q->dphi;
+  q->dss = q->cs * dpsi;
+  q->st = m->sigma_t;
+  q->dst = 0.0;
+  q->st_apex = 0;
+  double apex = INFINITY, dapex = 0.0;
+  if (m->surface == MPMC_MC_MOHR_COULOMB) {
+    q->eta = q->xi = q->etab = q->deta = q->dxi = q->detab = 0.0;
+    if (q->sf > 0.0) {
+      apex = q->c * q->cf / q->sf;
+      dapex = q->dc * q->cf / q->sf - q->c * q->dphi / (q->sf * q->sf);
+    }
+  } else {
+    double dpe, dpx, dpb, unused;
+    dp_coef(m->surface, phi, &q->eta, &q->xi, &dpe, &dpx);
+    dp_coef(m->surface, psi, &q->etab, &unused, &dpb, &unused);
+    q->deta = dpe * q->dphi;
+    q->dxi = dpx * q->dphi;
+    q->detab = dpb * dpsi;
+    if (q->eta > 0.0) {
+      apex = q->xi * q->c / q->eta;
+      dapex = (q->dxi * q->c + q->xi * q->dc) / q->eta - apex * q->deta / q->eta;
+    }
+  }
+  if (!(q->st < apex)) { /* also sigma_t = INFINITY with an apex */
+    q->st = apex;
+    q->dst = dapex;
+    q->st_apex = isfinite(apex);
+  }
+}
+
+static inline double e_of(const mpmc_mc_param *m, double ep) {
+  return m->eta > 0.0 ? exp(-m->eta * ep) : 1.0;
+}
+
+static inline void sys_mat(const mc_sys *S, double D, mc_mat *q) {
+  if (S->frozen)
+    mat_eval(S->m, S->e_frozen, 1, q);
+  else
+    mat_eval(S->m, e_of(S->m, S->ep0 + D), 0, q);
+}
+
+/* De v in principal space */
+static inline void de_mul(const mpmc_mc_param *m, const double v[3], double out[3]) {
+  const double lam = m->K - 2.0 * m->G / 3.0, tr = v[0] + v[1] + v[2];
+  for (int a = 0; a < 3; ++a) out[a] = lam * tr + 2.0 * m->G * v[a];
+}
+
+static inline double dot3(const double a[3], const double b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* A plane surface s: gradient a, flow N, their eps_p-derivatives, strength k (f = a.s - k) */
+static void plane(int s, const mc_mat *q, double a[3], double da[3], double N[3], double dN[3],
+                  double *k, double *dk) {
+  for (int i = 0; i < 3; ++i) a[i] = da[i] = N[i] = dN[i] = 0.0;
+  if (s <= S_C) {
+    const int I = mc_ij[s][0], J = mc_ij[s][1];
+    a[I] = 1.0 + q->sf;
+    a[J] = -(1.0 - q->sf);
+    da[I] = da[J] = q->dsf;
+    N[I] = 1.0 + q->ss;
+    N[J] = -(1.0 - q->ss);
+    dN[I] = dN[J] = q->dss;
+    *k = 2.0 * q->c * q->cf;
+    *dk = 2.0 * (q->dc * q->cf + q->c * q->dcf);
+  } else {
+    a[s - S_T1] = N[s - S_T1] = 1.0;
+    *k = q->st;
+    *dk = q->dst;
+  }
+}
+
+/* Mohr-Coulomb yield function of plane (I, J) and Drucker-Prager's, at a stress s */
+static inline double mc_f(const mc_mat *q, const double s[3], int I, int J) {
+  return (s[I] - s[J]) + (s[I] + s[J]) * q->sf - 2.0 * q->c * q->cf;
+}
+static inline double dp_sqrtj2(const double s[3]) {
+  const double p = (s[0] + s[1] + s[2]) / 3.0;
+  const double a = s[0] - p, b = s[1] - p, c = s[2] - p;
+  return sqrt(0.5 * (a * a + b * b + c * c));
+}
+static inline double dp_f(const mc_mat *q, const double s[3]) {
+  return dp_sqrtj2(s) + q->eta * (s[0] + s[1] + s[2]) / 3.0 - q->xi * q->c;
+}
+
+/* Residuals R[0..n], the Jacobian J (may be NULL) and the stress sig (may be NULL) of a
+ * region of planes at y. */
+static void eval_planes(const mc_sys *S, const double *y, double *R, double J[MC_NMAX][MC_NMAX],
+                        double sig[3]) {
+  const int n = S->n;
+  const mpmc_mc_param *m = S->m;
+  mc_mat q;
+  sys_mat(S, y[n], &q);
+  double a[3][3], da[3][3], N[3][3], dN[3][3], k[3], dk[3], M[3] = {0, 0, 0}, dM[3] = {0, 0, 0};
+  for (int j = 0; j < n; ++j) {
+    plane(S->act[j], &q, a[j], da[j], N[j], dN[j], &k[j], &dk[j]);
+    for (int i = 0; i < 3; ++i) {
+      M[i] += y[j] * N[j][i];
+      dM[i] += y[j] * dN[j][i];
+    }
+  }
+  double DM[3], s[3];
+  de_mul(m, M, DM);
+  for (int i = 0; i < 3; ++i) s[i] = S->str[i] - DM[i];
+  for (int i = 0; i < n; ++i) R[i] = dot3(a[i], s) - k[i];
+  const double trM = (M[0] + M[1] + M[2]) / 3.0;
+  double u[3] = {M[0] - trM, M[1] - trM, M[2] - trM};
+  const double nd = sqrt(dot3(u, u)), c23 = sqrt(2.0 / 3.0);
+  R[n] = y[n] - c23 * nd;
+  if (sig)
+    for (int i = 0; i < 3; ++i) sig[i] = s[i];
+  if (!J) return;
+  for (int i = 0; i < 3; ++i) u[i] = nd > 0.0 ? u[i] / nd : 0.0;
+  double DdM[3];
+  de_mul(m, dM, DdM);
+  for (int j = 0; j < n; ++j) {
+    double DN[3];
+    de_mul(m, N[j], DN);
+    for (int i = 0; i < n; ++i) J[i][j] = -dot3(a[i], DN);
+    J[n][j] = -c23 * dot3(u, N[j]);
+  }
+  for (int i = 0; i < n; ++i) J[i][n] = dot3(da[i], s) - dk[i] - dot3(a[i], DdM);
+  J[n][n] = 1.0 - c23 * dot3(u, dM);
+}
+
+/* The same for a region with Drucker-Prager's cone (and cut-off planes).  The Jacobian is
+ * analytic for the cone alone (the hot path), by forward differences with the cut-off. */
+static void eval_dp(const mc_sys *S, const double *y, double *R, double J[MC_NMAX][MC_NMAX],
+                    double sig[3]) {
+  const int n = S->n;
+  const mpmc_mc_param *m = S->m;
+  mc_mat q;
+  sys_mat(S, y[n], &q);
+  int jd = -1; /* the cone's place in y; -1: cut-off planes only */
+  double M[3] = {0, 0, 0}, x[3], DM[3];
+  for (int j = 0; j < n; ++j) {
+    if (S->act[j] == S_DP) {
+      jd = j;
+      continue;
+    }
+    M[S->act[j] - S_T1] += y[j];
+  }
+  de_mul(m, M, DM);
+  for (int i = 0; i < 3; ++i) x[i] = S->str[i] - DM[i];
+  const double px = (x[0] + x[1] + x[2]) / 3.0, yd = jd >= 0 ? y[jd] : 0.0;
+  const double sx[3] = {x[0] - px, x[1] - px, x[2] - px};
+  const double rj = sqrt(0.5 * dot3(sx, sx));
+  const double ratio = rj > 0.0 ? 1.0 - m->G * yd / rj : 0.0;
+  const double p = px - m->K * q.etab * yd;
+  double s[3];
+  for (int i = 0; i < 3; ++i) s[i] = p + ratio * sx[i];
+  for (int j = 0; j < n; ++j)
+    R[j] = S->act[j] == S_DP ? rj - m->G * yd + q.eta * p - q.xi * q.c : s[S->act[j] - S_T1] - q.st;
+  /* plastic deviatoric strain: the cut-off's dev M and the cone's yd s_x / (2 sqrt J2) */
+  const double trM = (M[0] + M[1] + M[2]) / 3.0;
+  double u[3];
+  for (int i = 0; i < 3; ++i) u[i] = M[i] - trM + (rj > 0.0 ? yd * sx[i] / (2.0 * rj) : 0.0);
+  R[n] = y[n] - sqrt(2.0 / 3.0) * sqrt(dot3(u, u));
+  if (sig)
+    for (int i = 0; i < 3; ++i) sig[i] = s[i];
+  if (!J) return;
+  if (n == 1 && jd == 0) { /* the cone alone: R_n = D - |yd| / sqrt3 */
+    J[0][0] = -m->G - m->K * q.eta * q.etab;
+    J[0][1] = q.deta * p - q.eta * m->K * q.detab * yd - q.dxi * q.c - q.xi * q.dc;
+    J[1][0] = (yd >= 0.0 ? -1.0 : 1.0) / sqrt(3.0);
+    J[1][1] = 1.0;
+    return;
+  }
+  for (int j = 0; j <= n; ++j) {
+    double yp[MC_NMAX], Rp[MC_NMAX];
+    memcpy(yp, y, sizeof yp);
+    const double h = 1e-7 * (fabs(y[j]) + S->yscale);
+    yp[j] += h;
+    eval_dp(S, yp, Rp, NULL, NULL);
+    for (int i = 0; i <= n; ++i) J[i][j] = (Rp[i] - R[i]) / h;
+  }
+}
+
+static inline void sys_eval(const mc_sys *S, const double *y, double *R,
+                            double J[MC_NMAX][MC_NMAX], double sig[3]) {
+  int cone = 0;
+  for (int j = 0; j < S->n; ++j) cone |= S->act[j] == S_DP;
+  if (cone) /* the cut-off alone is planes for Drucker-Prager too */
+    eval_dp(S, y, R, J, sig);
+  else
+    eval_planes(S, y, R, J, sig);
+}
+
+/* max of |R_i| / tol over the residuals (R_n in strain: times 2G) */
+static inline double rnorm(const mc_sys *S, const double *R) {
+  double r = 0.0;
+  for (int i = 0; i < S->n; ++i) r = fmax(r, fabs(R[i]));
+  r = fmax(r, 2.0 * S->m->G * fabs(R[S->n]));
+  return isfinite(r) ? r / S->tolf : INFINITY;
+}
+
+/* Gaussian elimination with partial pivoting of A x = b (n <= 4); b <- x; returns det A. */
+static double gauss(int n, double A[MC_NMAX][MC_NMAX], double *b) {
+  double det = 1.0;
+  for (int k = 0; k < n; ++k) {
+    int p = k;
+    for (int i = k + 1; i < n; ++i)
+      if (fabs(A[i][k]) > fabs(A[p][k])) p = i;
+    if (!(A[p][k] != 0.0)) return 0.0;
+    if (p != k) {
+      for (int j = 0; j < n; ++j) {
+        const double t = A[k][j];
+        A[k][j] = A[p][j];
+        A[p][j] = t;
+      }
+      const double t = b[k];
+      b[k] = b[p];
+      b[p] = t;
+      det = -det;
+    }
+    det *= A[k][k];
+    for (int i = k + 1; i < n; ++i) {
+      const double l = A[i][k] / A[k][k];
+      for (int j = k; j < n; ++j) A[i][j] -= l * A[k][j];
+      b[i] -= l * b[k];
+    }
+  }
+  for (int i = n - 1; i >= 0; --i) {
+    double s = b[i];
+    for (int j = i + 1; j < n; ++j) s -= A[i][j] * b[j];
+    b[i] = s / A[i][i];
+  }
+  return det;
+}
+
+/* det of the leading n x n block (n <= 3) */
+static double det_lead(int n, double J[MC_NMAX][MC_NMAX]) {
+  if (n == 1) return J[0][0];
+  if (n == 2) return J[0][0] * J[1][1] - J[0][1] * J[1][0];
+  return J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
+         J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+         J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+}
+
+/* Newton on the region's (n+1) x (n+1) system from y.  strict (auto): plain full steps, and
+ * return 1 ("unsafe") at the first sign of trouble: softening that flips the sign of the
+ * Jacobian's determinant against its elastic-perfectly-plastic part (the softening modulus
+ * beats the elastic one: the residual is not monotone and the full step may run away), a
+ * stall, or a non-finite value.  strict = 0 (newton): steps shortened by backtracking on
+ * |R|^2 (Armijo), so that it converges wherever the root is unique.  0 when converged. */
+static int newton(const mc_sys *S, int strict, double *y, mpmc_mc_info *info) {
+  const int n1 = S->n + 1;
+  double prev = INFINITY;
+  for (int it = 0; it < MC_MAX_ITERS; ++it) {
+    double R[MC_NMAX], J[MC_NMAX][MC_NMAX], dx[MC_NMAX];
+    sys_eval(S, y, R, J, NULL);
+    const double nr = rnorm(S, R);
+    if (nr <= 1.0) return 0;
+    if (!isfinite(nr)) return 1;
+    if (strict && it >= 3 && nr > 0.5 * prev) return 1;
+    const double detyy = det_lead(S->n, J);
+    for (int i = 0; i < n1; ++i) dx[i] = -R[i];
+    const double det = gauss(n1, J, dx);
+    if (!(det != 0.0) || !isfinite(det)) return 1;
+    if (strict && !S->frozen && det * detyy <= 0.0) return 1;
+    info->newton_iters++;
+    if (strict) {
+      for (int i = 0; i < n1; ++i) y[i] += dx[i];
+    } else {
+      double t = 1.0, yt[MC_NMAX] = {0, 0, 0, 0}, Rt[MC_NMAX];
+      /* keep D >= 0: below eps_p^n the strengths grow without bound */
+      if (y[S->n] + dx[S->n] < 0.0) t = 0.5 * y[S->n] / -dx[S->n];
+      int ok = 0;
+      for (int ls = 0; ls < 40 && !ok; ++ls, t *= 0.5) {
+        for (int i = 0; i < n1; ++i) yt[i] = y[i] + t * dx[i];
+        sys_eval(S, yt, Rt, NULL, NULL);
+        const double nt = rnorm(S, Rt);
+        /* sufficient decrease of |R|^2 in the max norm's terms, or converged */
+        ok = nt <= 1.0 || nt <= (1.0 - 1e-4 * t) * nr;
+      }
+      if (!ok) return 1;
+      memcpy(y, yt, sizeof yt);
+    }
+    prev = nr;
+  }
+  return 1;
+}
+
+/* The perfect-plasticity solution of the region with the parameters frozen at
+ * x_r + (x_p - x_r) e: planes in one linear solve (the multipliers do not depend on D),
+ * then D = sqrt(2/3) |dev dEps^p|; with Drucker-Prager's cone and the cut-off, Newton. */
+static int solve_frozen(const mc_sys *S0, double e, double *y, mpmc_mc_info *info) {
+  mc_sys S = *S0;
+  S.frozen = 1;
+  S.e_frozen = e;
+  const int n = S.n;
+  for (int i = 0; i < MC_NMAX; ++i) y[i] = 0.0;
+  if (S.dp && n > 1) return newton(&S, 0, y, info);
+  double R[MC_NMAX], J[MC_NMAX][MC_NMAX];
+  sys_eval(&S, y, R, J, NULL);
+  for (int i = 0; i < n; ++i) y[i] = -R[i];
+  const double det = gauss(n, J, y);
+  if (!(det != 0.0) || !isfinite(det)) return 1;
+  y[n] = 0.0;
+  sys_eval(&S, y, R, NULL, NULL);
+  y[n] = -R[n];
+  return 0;
+}
+
+/* ---- KINSOL, one memory per thread in the workspace's slot -------------------------- */
+typedef struct {
+  SUNContext ctx;
+  void *kmem;
+  N_Vector u, us, fs;
+  SUNMatrix A;
+  SUNLinearSolver LS;
+  const mc_sys *sys;
+} mc_kin;
+
+static void mc_kin_free(void *p) {
+  mc_kin *k = p;
+  if (!k) return;
+  if (k->kmem) KINFree(&k->kmem);
+  if (k->LS) SUNLinSolFree(k->LS);
+  if (k->A) SUNMatDestroy(k->A);
+  if (k->u) N_VDestroy(k->u);
+  if (k->us) N_VDestroy(k->us);
+  if (k->fs) N_VDestroy(k->fs);
+  if (k->ctx) SUNContext_Free(&k->ctx);
+  free(k);
+}
+
+/* The system padded to MC_NMAX unknowns (R = u on the unused ones), so one memory serves
+ * every region. */
+static int mc_kin_f(N_Vector u, N_Vector f, void *data) {
+  const mc_kin *k = data;
+  const int n1 = k->sys->n + 1;
+  double y[MC_NMAX], R[MC_NMAX];
+  for (int i = 0; i < MC_NMAX; ++i) y[i] = NV_Ith_S(u, i);
+  sys_eval(k->sys, y, R, NULL, NULL);
+  int ok = 1;
+  for (int i = 0; i < MC_NMAX; ++i) {
+    NV_Ith_S(f, i) = i < n1 ? R[i] : y[i];
+    ok &= isfinite(NV_Ith_S(f, i));
+  }
+  return ok ? 0 : 1; /* > 0: recoverable, KINSOL shortens the step */
+}
+
+static int mc_kin_jac(N_Vector u, N_Vector fu, SUNMatrix Jm, void *data, N_Vector t1,
+                      N_Vector t2) {
+  (void)fu;
+  (void)t1;
+  (void)t2;
+  const mc_kin *k = data;
+  const int n1 = k->sys->n + 1;
+  double y[MC_NMAX], R[MC_NMAX], J[MC_NMAX][MC_NMAX];
+  for (int i = 0; i < MC_NMAX; ++i) y[i] = NV_Ith_S(u, i);
+  sys_eval(k->sys, y, R, J, NULL);
+  int ok = 1;
+  for (int i = 0; i < MC_NMAX; ++i)
+    for (int j = 0; j < MC_NMAX; ++j) {
+      const double v = i < n1 && j < n1 ? J[i][j] : (double)(i == j);
+      SM_ELEMENT_D(Jm, i, j) = v;
+      ok &= isfinite(v);
+    }
+  return ok ? 0 : 1;
+}
+
+static void mc_kin_err(int code, const char *module, const char *fn, char *msg, void *d) {
+  (void)code;
+  (void)module;
+  (void)fn;
+  (void)msg;
+  (void)d;
+}
+static void mc_kin_info(const char *module, const char *fn, char *msg, void *d) {
+  (void)module;
+  (void)fn;
+  (void)msg;
+  (void)d;
+}
+
+static int mc_kin_get(mpmc_rm_ws *ws, mc_kin **out) {
+  void **slot = mpmc_rm_ws_slot(ws, MPMC_RM_SLOT_MC, mc_kin_free);
+  if (!slot) return MPMC_ERR_ARG;
+  if (*slot) {
+    *out = *slot;
+    return MPMC_SUCCESS;
+  }
+  mc_kin *k = calloc(1, sizeof *k);
+  if (!k) return MPMC_ERR_MEMORY;
+  int ok = SUNContext_Create(NULL, &k->ctx) == 0;
+  if (ok) {
+    k->u = N_VNew_Serial(MC_NMAX, k->ctx);
+    k->us = N_VNew_Serial(MC_NMAX, k->ctx);
+    k->fs = N_VNew_Serial(MC_NMAX, k->ctx);
+    k->A = SUNDenseMatrix(MC_NMAX, MC_NMAX, k->ctx);
+    ok = k->u && k->us && k->fs && k->A;
+  }
+  if (ok) {
+    k->LS = SUNLinSol_Dense(k->u, k->A, k->ctx);
+    k->kmem = KINCreate(k->ctx);
+    ok = k->LS && k->kmem;
+  }
+  if (ok) {
+    N_VConst(0.0, k->u);
+    ok = KINInit(k->kmem, mc_kin_f, k->u) == KIN_SUCCESS &&
+         KINSetErrHandlerFn(k->kmem, mc_kin_err, NULL) == KIN_SUCCESS &&
+         KINSetInfoHandlerFn(k->kmem, mc_kin_info, NULL) == KIN_SUCCESS &&
+         KINSetPrintLevel(k->kmem, 0) == KIN_SUCCESS &&
+         KINSetUserData(k->kmem, k) == KIN_SUCCESS &&
+         KINSetLinearSolver(k->kmem, k->LS, k->A) == KIN_SUCCESS &&
+         KINSetJacFn(k->kmem, mc_kin_jac) == KIN_SUCCESS &&
+         /* a fresh Jacobian every iteration (TOOLCHAIN.md) */
+         KINSetMaxSetupCalls(k->kmem, 1) == KIN_SUCCESS &&
+         KINSetNumMaxIters(k->kmem, MC_MAX_ITERS) == KIN_SUCCESS &&
+         /* fscale = 1/tol: fnormtol 1 means |R| <= tol */
+         KINSetFuncNormTol(k->kmem, 1.0) == KIN_SUCCESS &&
+         KINSetScaledStepTol(k->kmem, 4.0 * DBL_EPSILON) == KIN_SUCCESS;
+  }
+  if (!ok) {
+    mc_kin_free(k);
+    return MPMC_ERR_MEMORY;
+  }
+  *slot = k;
+  *out = k;
+  return MPMC_SUCCESS;
+}
+
+/* KINSOL with line search from y; 0 converged, 1 not, or an error code (< 0 never: codes
+ * are positive, MPMC_ERR_MEMORY/ARG when KINSOL cannot be set up) */
+static int solve_kinsol(mpmc_rm_ws *ws, const mc_sys *S, double *y, mpmc_mc_info *info,
+                        int *err) {
+  mc_kin *k;
+  *err = ws ? mc_kin_get(ws, &k) : MPMC_ERR_ARG;
+  if (*err) return 1;
+  double R[MC_NMAX];
+  sys_eval(S, y, R, NULL, NULL);
+  if (rnorm(S, R) <= 1.0) return 0; /* KINSOL accepts a guess only at 0.01 fnormtol */
+  k->sys = S;
+  const int n = S->n;
+  for (int i = 0; i < MC_NMAX; ++i) {
+    NV_Ith_S(k->u, i) = i <= n ? y[i] : 0.0;
+    NV_Ith_S(k->us, i) = 1.0 / S->yscale;
+    NV_Ith_S(k->fs, i) = i < n ? 1.0 / S->tolf : i == n ? 2.0 * S->m->G / S->tolf : 1.0;
+  }
+  const int flag = KINSol(k->kmem, k->u, KIN_LINESEARCH, k->us, k->fs);
+  long nni = 0;
+  KINGetNumNonlinSolvIters(k->kmem, &nni);
+  info->kinsol_iters += (int)nni;
+  info->kinsol_flag = flag;
+  for (int i = 0; i <= n; ++i) y[i] = NV_Ith_S(k->u, i);
+  sys_eval(S, y, R, NULL, NULL);
+  /* a line search that stalls at round-off after reaching the tolerance is a success */
+  return rnorm(S, R) <= 1.0 ? 0 : 1;
+}
+
+/* Solve one region: 0 converged (y), 1 no solution found, or an error code via *err. */
+static int solve_region(mpmc_rm_ws *ws, int solver, const mc_sys *S, int perfect, double *y,
+                        mpmc_mc_info *info, int *err) {
+  *err = 0;
+  const double e0 = e_of(S->m, S->ep0);
+  if (perfect) {
+    if (solve_frozen(S, e0, y, info)) return 1;
+    double R[MC_NMAX];
+    mc_sys Sf = *S;
+    Sf.frozen = 1;
+    Sf.e_frozen = e0;
+    sys_eval(&Sf, y, R, NULL, NULL);
+    return rnorm(&Sf, R) <= 1.0 ? 0 : 1;
+  }
+  if (solver != MPMC_SOLVER_KINSOL) {
+    /* from the perfect-plasticity predictor at eps_p^n */
+    if (solve_frozen(S, e0, y, info))
+      for (int i = 0; i < MC_NMAX; ++i) y[i] = 0.0;
+    if (!newton(S, solver == MPMC_SOLVER_AUTO, y, info)) return 0;
+    if (solver == MPMC_SOLVER_NEWTON) { /* again from the largest return (below) */
+      if (solve_frozen(S, 0.0, y, info)) return 1;
+      return newton(S, 0, y, info);
+    }
+    info->fallback = 1;
+  }
+  /* KINSOL from the predictor at eps_p^n; failing that, from the predictor with the residual
+   * strengths: the largest return, from which the Newton steps of a concave residual approach
+   * the root monotonically (return_map.c) */
+  if (solve_frozen(S, e0, y, info))
+    for (int i = 0; i < MC_NMAX; ++i) y[i] = 0.0;
+  if (!solve_kinsol(ws, S, y, info, err) || *err) return *err ? 1 : 0;
+  if (solve_frozen(S, 0.0, y, info)) return 1;
+  return solve_kinsol(ws, S, y, info, err);
+}
+
+/* The returned stress s (at eps_p^n + D, parameters q) of region S: multipliers >= 0 and no
+ * surface violated. */
+static int admissible(const mc_sys *S, const double *y, const double s[3], const mc_mat *q) {
+  double ys = 0.0;
+  for (int j = 0; j < S->n; ++j) ys += fabs(y[j]);
+  for (int j = 0; j < S->n; ++j)
+    if (!(y[j] >= -1e-9 * ys)) return 0;
+  if (!(y[S->n] >= -1e-12 * S->yscale)) return 0;
+  const double tol = 8.0 * S->tolf;
+  for (int a = 0; a < 3; ++a)
+    if (!(s[a] <= q->st + tol)) return 0;
+  if (S->dp) {
+    if (!(dp_f(q, s) <= tol)) return 0;
+    /* the cone's return may not overshoot the axis */
+    for (int j = 0; j < S->n; ++j)
+      if (S->act[j] == S_DP) {
+        double x[3], M[3] = {0, 0, 0}, DM[3];
+        for (int i = 0; i < S->n; ++i)
+          if (S->act[i] != S_DP) M[S->act[i] - S_T1] += y[i];
+        de_mul(S->m, M, DM);
+        for (int i = 0; i < 3; ++i) x[i] = S->str[i] - DM[i];
+        if (!(S->m->G * y[j] <= dp_sqrtj2(x) * (1.0 + 1e-12))) return 0;
+      }
+  } else {
+    for (int I = 0; I < 3; ++I)
+      for (int J = 0; J < 3; ++J)
+        if (I != J && !(mc_f(q, s, I, J) <= tol)) return 0;
+  }
+  return 1;
+}
+
+typedef struct {
+  int n, act[3], region;
+} mc_region;
+static const mc_region mc_regions[] = {
+    {1, {S_A, 0, 0}, MPMC_MC_PLANE},
+    {2, {S_A, S_B, 0}, MPMC_MC_EDGE_COMPRESSION},
+    {2, {S_A, S_C, 0}, MPMC_MC_EDGE_EXTENSION},
+    {1, {S_T1, 0, 0}, MPMC_MC_TENSION},
+    {2, {S_A, S_T1, 0}, MPMC_MC_TENSION_EDGE},
+    {2, {S_T1, S_T2, 0}, MPMC_MC_TENSION_EDGE},
+    {3, {S_A, S_C, S_T1}, MPMC_MC_TENSION_CORNER},
+    /* s1 = s2 = sigma_t on the surface: four generators, so every triple (Caratheodory) */
+    {3, {S_A, S_B, S_T1}, MPMC_MC_TENSION_CORNER},
+    {3, {S_A, S_T1, S_T2}, MPMC_MC_TENSION_CORNER},
+    {3, {S_B, S_T1, S_T2}, MPMC_MC_TENSION_CORNER},
+    {3, {S_A, S_B, S_T2}, MPMC_MC_TENSION_CORNER},
+};
+static const mc_region dp_regions[] = {
+    {1, {S_DP, 0, 0}, MPMC_MC_PLANE},
+    {1, {S_T1, 0, 0}, MPMC_MC_TENSION},
+    {2, {S_DP, S_T1, 0}, MPMC_MC_TENSION_EDGE},
+    {2, {S_T1, S_T2, 0}, MPMC_MC_TENSION_EDGE},
+    {3, {S_DP, S_T1, S_T2}, MPMC_MC_TENSION_CORNER},
+};
+
+/**
+ * @brief c, phi and psi of the softened material at eps_p (return_mc.h).
+ */
+void mpmc_mc_soften(const mpmc_mc_param *m, double eps_p, double *c, double *phi, double *psi) {
+  const double e = e_of(m, eps_p);
+  if (c) *c = m->c_r + (m->c_p - m->c_r) * e;
+  if (phi) *phi = m->phi_r + (m->phi_p - m->phi_r) * e;
+  if (psi) *psi = m->psi_r + (m->psi_p - m->psi_r) * e;
+}
+
+/**
+ * @brief The tolerance on the yield functions [Pa] for a trial stress: 1e-12 of the largest
+ * of |tau_trial|, c_p and a finite sigma_t (the round-off of the returned stress is ~1e-16
+ * of |tau_trial|).
+ */
+double mpmc_mc_tolerance(const mpmc_mc_param *m, const double t[3]) {
+  double s = fmax(fmax(fabs(t[0]), fabs(t[1])), fmax(fabs(t[2]), m->c_p));
+  if (isfinite(m->sigma_t)) s = fmax(s, fabs(m->sigma_t));
+  return 1e-12 * s + DBL_MIN;
+}
+
+/**
+ * @brief Frictional return map of one point in principal space (return_mc.h).
+ * @param ws      per-thread workspace (KINSOL's memory; may be NULL for MPMC_SOLVER_NEWTON
+ *                and for perfect plasticity)
+ * @param solver  MPMC_SOLVER_AUTO, _NEWTON or _KINSOL (as for J2, return_map.c)
+ * @param m       material
+ * @param eps_tr  trial principal elastic log strains, any order
+ * @param eps_p   accumulated plastic deviatoric strain, in/out
+ * @param eps     returned principal elastic log strains (order of eps_tr)
+ * @param tau     returned principal Kirchhoff stresses (order of eps_tr)
+ * @param info    statistics (may be NULL)
+ * @return 0, MPMC_ERR_ARG (bad material), MPMC_ERR_NUMERIC (non-finite input),
+ *         MPMC_ERR_SOLVER (no region converged and admissible), MPMC_ERR_MEMORY; on failure
+ *         eps_p, eps and tau are left unchanged.
+ */
+int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
+                             const double eps_tr[3], double *eps_p, double eps[3],
+                             double tau[3], mpmc_mc_info *info) {
+  mpmc_mc_info local;
+  if (!info) info = &local;
+  memset(info, 0, sizeof *info);
+  if (!m || !eps_tr || !eps_p || !eps || !tau) return MPMC_ERR_ARG;
+  if (!(m->K > 0 && m->G > 0 && m->c_r >= 0 && m->c_p >= m->c_r && m->eta >= 0 &&
+        m->phi_p >= 0 && m->phi_r >= 0 && m->phi_p < 0.5 * acos(-1.0) && m->phi_r < 0.5 * acos(-1.0) &&
+        fabs(m->psi_p) <= m->phi_p && fabs(m->psi_r) <= m->phi_r && !isnan(m->sigma_t) &&
+        m->surface >= MPMC_MC_MOHR_COULOMB && m->surface <= MPMC_DP_PLANE_STRAIN &&
+        isfinite(m->K) && isfinite(m->G) && isfinite(m->c_p) && isfinite(m->eta)))
+    return MPMC_ERR_ARG;
+  if (!(isfinite(eps_tr[0]) && isfinite(eps_tr[1]) && isfinite(eps_tr[2]) && isfinite(*eps_p) &&
+        *eps_p >= 0))
+    return MPMC_ERR_NUMERIC;
+  /* sort: perm[k] = the input index of the k-th largest */
+  int perm[3] = {0, 1, 2};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2 - i; ++j)
+      if (eps_tr[perm[j]] < eps_tr[perm[j + 1]]) {
+        const int t = perm[j];
+        perm[j] = perm[j + 1];
+        perm[j + 1] = t;
+      }
+  const double tr = eps_tr[0] + eps_tr[1] + eps_tr[2];
+  mc_sys S = {.m = m, .dp = m->surface != MPMC_MC_MOHR_COULOMB, .ep0 = *eps_p};
+  for (int k = 0; k < 3; ++k) S.str[k] = m->K * tr + 2.0 * m->G * (eps_tr[perm[k]] - tr / 3.0);
+  if (!(isfinite(S.str[0]) && isfinite(S.str[2]))) return MPMC_ERR_NUMERIC;
+  S.tolf = mpmc_mc_tolerance(m, S.str);
+  S.yscale = fmax(fabs(S.str[0]), fabs(S.str[2])) / m->G + 1e-300;
+  mc_mat q0;
+  mat_eval(m, e_of(m, S.ep0), 1, &q0);
+  const double f0 = S.dp ? dp_f(&q0, S.str) : mc_f(&q0, S.str, 0, 2);
+  double s[3], ep_new = S.ep0;
+  if (f0 <= S.tolf && S.str[0] <= q0.st + S.tolf) { /* elastic */
+    for (int a = 0; a < 3; ++a) {
+      eps[a] = eps_tr[a];
+      tau[a] = m->K * tr + 2.0 * m->G * (eps_tr[a] - tr / 3.0);
+    }
+    return MPMC_SUCCESS;
+  }
+  info->plastic = 1;
+  const int perfect = m->eta == 0.0 ||
+                      (m->c_p == m->c_r && m->phi_p == m->phi_r && m->psi_p == m->psi_r);
+  const mc_region *regs = S.dp ? dp_regions : mc_regions;
+  const int nreg = S.dp ? (int)(sizeof dp_regions / sizeof dp_regions[0])
+                        : (int)(sizeof mc_regions / sizeof mc_regions[0]);
+  const int tension = isfinite(q0.st) || isfinite(m->sigma_t);
+  int found = 0;
+  for (int r = 0; r < nreg && !found; ++r) {
+    int uses_t = 0;
+    for (int j = 0; j < regs[r].n; ++j) uses_t |= regs[r].act[j] >= S_T1 && regs[r].act[j] <= S_T3;
+    if (uses_t && !tension) continue;
+    S.n = regs[r].n;
+    memcpy(S.act, regs[r].act, sizeof S.act);
+    double y[MC_NMAX] = {0, 0, 0, 0}, R[MC_NMAX];
+    int err = 0;
+    const int fail = solve_region(ws, solver, &S, perfect, y, info, &err);
+    if (err) return err;
+    if (fail) continue;
+    mc_sys Se = S;
+    if (perfect) {
+      Se.frozen = 1;
+      Se.e_frozen = e_of(m, S.ep0);
+    }
+    sys_eval(&Se, y, R, NULL, s);
+    mc_mat q;
+    mat_eval(m, perfect ? e_of(m, S.ep0) : e_of(m, S.ep0 + y[S.n]), 1, &q);
+    if (!admissible(&S, y, s, &q)) continue;
+    found = 1;
+    info->region = regs[r].region;
+    info->dgamma = 0.0;
+    info->residual = 0.0;
+    for (int j = 0; j < S.n; ++j) {
+      info->dgamma += y[j];
+      info->residual = fmax(info->residual, fabs(R[j]));
+    }
+    ep_new = S.ep0 + y[S.n];
+    /* a return to the apex through a cut-off capped there is the apex */
+    if (q.st_apex && s[0] - s[2] <= 8.0 * S.tolf) info->region = MPMC_MC_APEX;
+  }
+  if (!found) {
+    /* the hydrostatic point s = sigma_c 1, sigma_c the cut-off or the apex: D follows from
+     * the trial deviator alone, D = sqrt(2/3) |dev s_tr| / 2G */
+    const double p = (S.str[0] + S.str[1] + S.str[2]) / 3.0;
+    const double dv[3] = {S.str[0] - p, S.str[1] - p, S.str[2] - p};
+    const double D = sqrt(2.0 / 3.0) * sqrt(dot3(dv, dv)) / (2.0 * m->G);
+    mc_mat q;
+    mat_eval(m, perfect ? e_of(m, S.ep0) : e_of(m, S.ep0 + D), 1, &q);
+    /* the volume must shrink back (the apex is reached by a volumetric plastic expansion) */
+    if (!isfinite(q.st) || !(p >= q.st - S.tolf)) return MPMC_ERR_SOLVER;
+    s[0] = s[1] = s[2] = q.st;
+    ep_new = S.ep0 + D;
+    info->region = q.st_apex ? MPMC_MC_APEX : MPMC_MC_TENSION_CORNER;
+    info->dgamma = (p - q.st) / m->K + D; /* volumetric and deviatoric parts, for the record */
+    info->residual = 0.0;
+  }
+  if (!(isfinite(s[0]) && isfinite(s[1]) && isfinite(s[2]) && isfinite(ep_new)))
+    return MPMC_ERR_SOLVER;
+  const double p = (s[0] + s[1] + s[2]) / 3.0;
+  for (int k = 0; k < 3; ++k) {
+    tau[perm[k]] = s[k];
+    eps[perm[k]] = (s[k] - p) / (2.0 * m->G) + p / (3.0 * m->K);
+  }
+  *eps_p = ep_new;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief The frictional return map of one point in tensor form (return_mc.h), by the
+ * eigen-decomposition of the trial b_e (the principal directions are kept).
+ * @param F     relative deformation gradient, or NULL when be is already the trial state
+ * @param be    elastic left Cauchy-Green tensor (Voigt), in/out
+ * @param eps_p accumulated plastic deviatoric strain, in/out
+ * @param tau   Kirchhoff stress out (Voigt); J_out = sqrt(det b_e) (may be NULL)
+ * @return 0, MPMC_ERR_NUMERIC (b_e not positive definite or not finite) or the principal
+ *         return's code; on failure be, eps_p and tau are unchanged.
+ */
+int mpmc_mc_return_map(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double F[3][3],
+                       double *be, double *eps_p, double *tau, double *J_out,
+                       mpmc_mc_info *info) {
+  double b[6], lam[3], Q[3][3], etr[3], e[3], t[3];
+  for (int k = 0; k < 6; ++k) b[k] = be[k];
+  if (F) mpmc_push_forward(F, b);
+  mpmc_sym3_eig(b, lam, Q);
+  for (int a = 0; a < 3; ++a) {
+    if (!(lam[a] > 0.0) || !isfinite(lam[a])) return MPMC_ERR_NUMERIC;
+    etr[a] = 0.5 * log(lam[a]);
+  }
+  double ep = *eps_p;
+  MPMC_CALL(mpmc_mc_return_principal(ws, solver, m, etr, &ep, e, t, info));
+  for (int a = 0; a < 3; ++a) lam[a] = exp(2.0 * e[a]);
+  mpmc_sym3_compose(lam, Q, be);
+  mpmc_sym3_compose(t, Q, tau);
+  if (J_out) *J_out = exp(e[0] + e[1] + e[2]);
+  *eps_p = ep;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Strength reduction by factor (the SRM of slope stability): c_p, c_r, sigma_t
+ * divided by it, and tan of phi_p, phi_r, psi_p, psi_r.
+ */
+void mpmc_mc_reduce(mpmc_mc_param *m, double factor) {
+  m->c_p /= factor;
+  m->c_r /= factor;
+  m->sigma_t /= factor;
+  m->phi_p = atan(tan(m->phi_p) / factor);
+  m->phi_r = atan(tan(m->phi_r) / factor);
+  m->psi_p = atan(tan(m->psi_p) / factor);
+  m->psi_r = atan(tan(m->psi_r) / factor);
+}

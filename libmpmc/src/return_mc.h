@@ -1,0 +1,102 @@
+/* Return mapping for Hencky elasticity with the frictional yield surfaces of soils:
+ * Mohr-Coulomb and its three Drucker-Prager matchings, each with a tension cut-off on the
+ * largest principal stress, non-associated flow and exponential softening (private; used by
+ * the material table, the tests and bench/).
+ *
+ * Elasticity as in return_map.h: principal elastic log strains eps_a = 1/2 ln lam_a of b_e,
+ * Kirchhoff principal stresses tau_a = K tr(eps) + 2G dev(eps)_a.  Tension positive.
+ * Principal stresses sorted s1 >= s2 >= s3 (s3 the most compressive); with p = tr(tau)/3:
+ *   Mohr-Coulomb  f  = (s1 - s3) + (s1 + s3) sin(phi) - 2 c cos(phi),
+ *                 g  = (s1 - s3) + (s1 + s3) sin(psi)            (plastic potential),
+ *   Drucker-Prager f = sqrt(J2) + eta_f(phi) p - xi(phi) c,  g = sqrt(J2) + eta_f(psi) p,
+ *     the matchings of de Souza Neto, Peric & Owen 2008 (sections 6.4.3 and 8.3):
+ *       compression (outer) cone  eta_f = 6 sin / (sqrt3 (3 - sin)), xi = 6 cos / (sqrt3 (3 - sin))
+ *       extension (inner) cone    eta_f = 6 sin / (sqrt3 (3 + sin)), xi = 6 cos / (sqrt3 (3 + sin))
+ *       plane strain              eta_f = 3 tan / sqrt(9 + 12 tan^2),  xi = 3 / sqrt(9 + 12 tan^2)
+ *   tension cut-off  s1 <= sigma_t, associated (Rankine) flow; capped at the apex
+ *                    (c cot(phi) for Mohr-Coulomb, xi c / eta_f for Drucker-Prager) whenever
+ *                    the apex exists (phi > 0): the cap changes no elastic state and supplies
+ *                    the volumetric flow that returns a trial state beyond the apex.
+ * Softening: c, phi and psi each x(eps_p) = x_r + (x_p - x_r) exp(-eta eps_p), where eps_p
+ * is the accumulated plastic deviatoric strain, eps_p += sqrt(2/3) |dev(d eps^p)| per step
+ * (J2's measure for an isochoric flow; the cut-off's flow softens too).  sigma_t does not
+ * soften, but its cap at the apex follows c and phi.  Implicit (backward Euler): every
+ * quantity at eps_p^{n+1}.
+ *
+ * The return map tries the sets of active surfaces of the region list below, in order, and
+ * takes the first whose multipliers are >= 0 and whose stress violates no surface (the
+ * Kuhn-Tucker conditions; for perfect associated plasticity this is the unique closest point
+ * in the energy norm).  Perfect plasticity: the surfaces are planes in principal stress
+ * space and each region's multipliers are one linear solve (Mohr-Coulomb; Drucker-Prager's
+ * cone alone likewise; its corners with the cut-off need a few Newton steps).  Softening:
+ * Newton on the multipliers and the increment of eps_p ((n+1) x (n+1), n <= 3 active
+ * surfaces: 2 x 2 on a plane, 3 x 3 on an edge), with KINSOL as the fallback exactly as
+ * for J2 (MPMC_SOLVER_*, return_map.c). */
+#ifndef MPMC_RETURN_MC_H
+#define MPMC_RETURN_MC_H
+
+#include "return_map.h"
+
+/* mpmc_mc_param.surface */
+enum {
+  MPMC_MC_MOHR_COULOMB = 0,
+  MPMC_DP_COMPRESSION = 1, /* outer cone: Mohr-Coulomb's strength in triaxial compression */
+  MPMC_DP_EXTENSION = 2,   /* inner cone: Mohr-Coulomb's strength in triaxial extension   */
+  MPMC_DP_PLANE_STRAIN = 3 /* Mohr-Coulomb's plane-strain strength (associated flow)     */
+};
+
+/* mpmc_mc_info.region: where the stress returned to (s1 >= s2 >= s3) */
+enum {
+  MPMC_MC_ELASTIC = 0,
+  MPMC_MC_PLANE = 1,            /* main plane s1-s3 of Mohr-Coulomb; Drucker-Prager: the cone */
+  MPMC_MC_EDGE_COMPRESSION = 2, /* s1 = s2 on Mohr-Coulomb (triaxial compression meridian)   */
+  MPMC_MC_EDGE_EXTENSION = 3,   /* s2 = s3 on Mohr-Coulomb (triaxial extension meridian)     */
+  MPMC_MC_APEX = 4,             /* the hydrostatic apex (the cut-off is at or above it)       */
+  MPMC_MC_TENSION = 5,          /* the cut-off plane s1 = sigma_t alone                       */
+  MPMC_MC_TENSION_EDGE = 6,     /* two surfaces with the cut-off: s1 = sigma_t on the yield
+                                   surface, or s1 = s2 = sigma_t                              */
+  MPMC_MC_TENSION_CORNER = 7    /* three or more with the cut-off: s1 = sigma_t on either
+                                   edge, s1 = s2 = sigma_t on the yield surface, or the
+                                   hydrostatic corner s = sigma_t below the apex              */
+};
+
+typedef struct {
+  double K, G;         /* bulk, shear modulus [Pa]                                        */
+  double c_p, c_r;     /* cohesion peak, residual [Pa], 0 <= c_r <= c_p                    */
+  double phi_p, phi_r; /* friction angle peak, residual [rad]                              */
+  double psi_p, psi_r; /* dilation angle peak, residual [rad], psi <= phi                  */
+  double eta;          /* softening rate of c, phi, psi with eps_p (>= 0; 0: perfect)       */
+  double sigma_t;      /* tension cut-off [Pa] on the largest principal stress; INFINITY:
+                          none (then the apex, when phi > 0)                                 */
+  int surface;         /* MPMC_MC_MOHR_COULOMB, MPMC_DP_*                                    */
+} mpmc_mc_param;
+
+/* What one return map did. */
+typedef struct {
+  int plastic;      /* 1 if the trial state was outside the elastic domain               */
+  int region;       /* MPMC_MC_* above                                                   */
+  int fallback;     /* 1 if the auto solver handed (some region of) this point to KINSOL  */
+  int newton_iters; /* Newton iterations over all regions tried                          */
+  int kinsol_iters; /* KINSOL nonlinear iterations                                       */
+  int kinsol_flag;  /* the last KINSol return value (0 when KINSOL was not called)        */
+  double dgamma;    /* sum of the plastic multipliers of the accepted region             */
+  double residual;  /* max |f| of the active surfaces after the return [Pa]              */
+} mpmc_mc_info;
+
+/* The material at eps_p (softened c, phi, psi): c, phi, psi in that order, for the tests. */
+void mpmc_mc_soften(const mpmc_mc_param *m, double eps_p, double *c, double *phi, double *psi);
+
+/* The convergence tolerance on f [Pa] of a trial state with principal stresses tau_tr. */
+double mpmc_mc_tolerance(const mpmc_mc_param *m, const double tau_tr[3]);
+
+int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
+                             const double eps_tr[3], double *eps_p, double eps[3],
+                             double tau[3], mpmc_mc_info *info);
+
+int mpmc_mc_return_map(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double F[3][3],
+                       double *be, double *eps_p, double *tau, double *J_out,
+                       mpmc_mc_info *info);
+
+void mpmc_mc_reduce(mpmc_mc_param *m, double factor);
+
+#endif
