@@ -20,10 +20,15 @@
  * LAPACK: libmpmc does not link it (OpenBLAS starts its threads when it is loaded).
  * liblapacke.so.3 is opened at the first plastic point of a user surface (once per process,
  * then openblas_set_num_threads(1): these solves run inside OpenMP regions).  Newton's 7x7
- * systems go to a hand-written Gaussian elimination with partial pivoting (4x faster than
- * LAPACKE_dgesv on 7x7, bench_user_yield) unless param.lapack = 1; KINSOL's go to LAPACK
- * dgetrf/dgetrs through a small SUNLinearSolver of ours (Debian's SUNDIALS has no
- * SUNLinSol_LapackDense). */
+ * systems go to a hand-written Gaussian elimination with partial pivoting unless
+ * param.lapack = 1 (bench_user_yield: 151 ns a solve against LAPACKE_dgesv's 401, 1.9 us
+ * against 2.5 us a plastic point); KINSOL's go to LAPACK dgetrf/dgetrs through a small
+ * SUNLinearSolver of ours (Debian's SUNDIALS has no SUNLinSol_LapackDense).
+ *
+ * Starts: Newton from (tau_trial, 0) with a perfect-plasticity first step (df/dalpha left
+ * out, as the built-in J2 starts from kappa(eps_p)); NEWTON retries once from
+ * predictor_start's point, KINSOL (and AUTO's fallback) starts there: the first point past
+ * the surface on the predictor's line, from which steep softening converges too. */
 #ifndef MPMC_RETURN_CPP_H
 #define MPMC_RETURN_CPP_H
 
@@ -36,7 +41,7 @@ enum {
   MPMC_CPP_OK = 0,
   MPMC_CPP_NO_CONVERGENCE = 1, /* Newton and/or KINSOL did not converge                   */
   MPMC_CPP_USER_ERROR = 2,     /* the yield function returned non-zero (info.user_code)   */
-  MPMC_CPP_NON_FINITE = 3,     /* NaN/Inf in the trial state or the function's values     */
+  MPMC_CPP_NON_FINITE = 3,     /* NaN/Inf in the trial state or the function's values there */
   MPMC_CPP_NO_LAPACK = 4,      /* liblapacke.so.3 could not be loaded                      */
   MPMC_CPP_NO_WORKSPACE = 5    /* KINSOL needed but ws == NULL, or its memory failed      */
 };
