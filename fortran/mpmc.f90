@@ -53,7 +53,7 @@ module mpmc
   integer(c_int), parameter, public :: MPMC_FIELD_POSITION = 0, MPMC_FIELD_VELOCITY = 1, &
     MPMC_FIELD_MASS = 2, MPMC_FIELD_VOLUME0 = 3, MPMC_FIELD_J = 4, MPMC_FIELD_JBAR = 5, &
     MPMC_FIELD_STRESS = 6, MPMC_FIELD_BE = 7, MPMC_FIELD_EPS_P = 8, MPMC_FIELD_FORCE = 9, &
-    MPMC_FIELD_X0 = 10, MPMC_FIELD_COUNT = 11
+    MPMC_FIELD_X0 = 10, MPMC_FIELD_REGION = 11, MPMC_FIELD_COUNT = 12
   ! phases of a step: stats%phase_seconds(MPMC_PHASE_P2G) (indexed from 0, as in C)
   integer(c_int), parameter, public :: MPMC_PHASE_SORT = 0, MPMC_PHASE_SLABS = 1, &
     MPMC_PHASE_P2G = 2, MPMC_PHASE_GRID = 3, MPMC_PHASE_G2P = 4, MPMC_PHASE_FBAR = 5, &
@@ -107,6 +107,54 @@ module mpmc
   end interface
   public :: mpmc_user_stress_fn
 
+  !> Drucker-Prager's fit to Mohr-Coulomb (mpmc_dp_match)
+  integer(c_int), parameter, public :: MPMC_DP_MATCH_COMPRESSION = 0, &
+    MPMC_DP_MATCH_EXTENSION = 1, MPMC_DP_MATCH_PLANE_STRAIN = 2
+  !> The largest number of parameters of a model (mpmc_sim_get_material's par)
+  integer(c_int), parameter, public :: MPMC_MAX_PARAMS = 16
+
+  !> What a user yield surface gives at (tau, alpha) (mpmc_yield_eval): Voigt xx yy zz yz xz
+  !> xy, tensor components; drdtau(j, i) = d r_i / d tau_j (C's row-major [6 i + j]).
+  type, bind(C), public :: mpmc_yield_eval
+    real(c_double) :: f = 0
+    real(c_double) :: dfdtau(6) = 0
+    real(c_double) :: dfdalpha = 0
+    real(c_double) :: r(6) = 0
+    real(c_double) :: drdtau(6, 6) = 0
+    real(c_double) :: drdalpha(6) = 0
+  end type mpmc_yield_eval
+
+  !> A user yield surface (mpmc_yield_fn): fill out at the Kirchhoff stress tau and the
+  !> hardening variable alpha.  Called from several threads at once: declare it recursive.
+  abstract interface
+    function mpmc_yield_fn(data, tau, alpha, out) bind(C) result(ierr)
+      import :: c_ptr, c_double, c_int, mpmc_yield_eval
+      type(c_ptr), value :: data
+      real(c_double), intent(in) :: tau(6)
+      real(c_double), value :: alpha
+      type(mpmc_yield_eval), intent(out) :: out
+      integer(c_int) :: ierr
+    end function mpmc_yield_fn
+  end interface
+  public :: mpmc_yield_fn
+
+  !> A model of the material table (mpmc_model_info); the strings through mpmc_f_string.
+  type, bind(C), public :: mpmc_model_info
+    type(c_ptr) :: name = c_null_ptr, doc = c_null_ptr
+    integer(c_int) :: nparam = 0, nstore = 0, plastic = 0, needs_function = 0
+  end type mpmc_model_info
+  !> One of its parameters (mpmc_param_info)
+  type, bind(C), public :: mpmc_param_info
+    type(c_ptr) :: name = c_null_ptr, unit = c_null_ptr, doc = c_null_ptr
+    real(c_double) :: lo = 0, hi = 0
+    integer(c_int) :: lo_open = 0, hi_open = 0, optional = 0
+    real(c_double) :: def = 0
+    integer(c_int) :: default_of = -1, at_most = -1, alias_of = -1
+    real(c_double) :: scale = 1
+    integer(c_int) :: strength = 0, nwords = 0
+    type(c_ptr) :: words = c_null_ptr
+  end type mpmc_param_info
+
   ! ---- public procedures: direct bindings (same name as the C symbol) ----------------------
   public :: mpmc_context_create, mpmc_context_destroy, mpmc_context_clear_error, &
     mpmc_context_set_log_level, mpmc_version
@@ -117,7 +165,12 @@ module mpmc
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
-    mpmc_sim_add_material_user, mpmc_sim_set_material_user_fn
+    mpmc_sim_add_material_user, mpmc_sim_set_material_user_fn, &
+    mpmc_sim_add_material_mohr_coulomb, mpmc_sim_add_material_drucker_prager, &
+    mpmc_sim_add_material_user_yield, mpmc_sim_set_material_yield_fn, &
+    mpmc_sim_set_strength_reduction, mpmc_sim_get_material, mpmc_model_count, &
+    mpmc_model_get_info, mpmc_model_get_param
+  public :: mpmc_model_find, mpmc_sim_add_material, mpmc_f_string
   public :: mpmc_sim_add_rigid_box, mpmc_sim_add_rigid_polygon, mpmc_sim_remove_rigid, &
     mpmc_sim_set_rigid_velocity, mpmc_sim_get_rigid_offset, mpmc_sim_get_rigid_reaction, &
     mpmc_sim_get_rigid_gap, mpmc_sim_set_contact_params, mpmc_sim_get_contact_params
@@ -406,6 +459,100 @@ module mpmc
       integer(c_int), value :: material
       type(c_funptr), value :: fn
       type(c_ptr), value :: data
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_strength_reduction(sim, material, factor) &
+        bind(C, name='mpmc_sim_set_strength_reduction') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: material
+      real(c_double), value :: factor
+      integer(c_int) :: ierr
+    end function
+    !> Angles in degrees; residual values NaN (ieee_value) for "the peak value";
+    !> sigma_t = huge(1.0_c_double) or +Inf for no tension cut-off beyond the apex.
+    function mpmc_sim_add_material_mohr_coulomb(sim, E, nu, rho, c, phi, psi, c_r, phi_r, &
+        psi_r, eta, sigma_t, id) bind(C, name='mpmc_sim_add_material_mohr_coulomb') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), value :: E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t
+      integer(c_int), intent(out) :: id
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_add_material_drucker_prager(sim, E, nu, rho, c, phi, psi, c_r, phi_r, &
+        psi_r, eta, sigma_t, match, id) bind(C, name='mpmc_sim_add_material_drucker_prager') &
+        result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), value :: E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t
+      integer(c_int), value :: match
+      integer(c_int), intent(out) :: id
+      integer(c_int) :: ierr
+    end function
+    !> fn = c_funloc(a procedure with the mpmc_yield_fn interface)
+    function mpmc_sim_add_material_user_yield(sim, fn, data, E, nu, rho, id) &
+        bind(C, name='mpmc_sim_add_material_user_yield') result(ierr)
+      import :: c_int, c_double, c_ptr, c_funptr, mpmc_sim
+      type(mpmc_sim), value :: sim
+      type(c_funptr), value :: fn
+      type(c_ptr), value :: data
+      real(c_double), value :: E, nu, rho
+      integer(c_int), intent(out) :: id
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_material_yield_fn(sim, material, fn, data) &
+        bind(C, name='mpmc_sim_set_material_yield_fn') result(ierr)
+      import :: c_int, c_ptr, c_funptr, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: material
+      type(c_funptr), value :: fn
+      type(c_ptr), value :: data
+      integer(c_int) :: ierr
+    end function
+    !> par(1:nstore) of the model (0-based model index); factor: the strength reduction
+    function mpmc_sim_get_material(sim, material, model, par, factor) &
+        bind(C, name='mpmc_sim_get_material') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: material
+      integer(c_int), intent(out) :: model
+      real(c_double), intent(out) :: par(*)
+      real(c_double), intent(out) :: factor
+      integer(c_int) :: ierr
+    end function
+    function mpmc_model_count(n) bind(C, name='mpmc_model_count') result(ierr)
+      import :: c_int
+      integer(c_int), intent(out) :: n
+      integer(c_int) :: ierr
+    end function
+    function mpmc_model_find_c(name, model) bind(C, name='mpmc_model_find') result(ierr)
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: name(*)
+      integer(c_int), intent(out) :: model
+      integer(c_int) :: ierr
+    end function
+    function mpmc_model_get_info(model, info) bind(C, name='mpmc_model_get_info') result(ierr)
+      import :: c_int, mpmc_model_info
+      integer(c_int), value :: model
+      type(mpmc_model_info), intent(out) :: info
+      integer(c_int) :: ierr
+    end function
+    !> parameter k (0-based) of the model
+    function mpmc_model_get_param(model, k, info) bind(C, name='mpmc_model_get_param') &
+        result(ierr)
+      import :: c_int, mpmc_param_info
+      integer(c_int), value :: model, k
+      type(mpmc_param_info), intent(out) :: info
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_add_material_c(sim, model, par, npar, id) &
+        bind(C, name='mpmc_sim_add_material') result(ierr)
+      import :: c_int, c_char, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      character(kind=c_char), intent(in) :: model(*)
+      real(c_double), intent(in) :: par(*)
+      integer(c_int), value :: npar
+      integer(c_int), intent(out) :: id
       integer(c_int) :: ierr
     end function
     function mpmc_sim_get_user_state_c(sim, material, state, nstate) &
@@ -871,6 +1018,32 @@ contains
       s(i:i) = chars(i)
     end do
   end function f_string
+
+  !> A C string (a char pointer of mpmc_model_info or mpmc_param_info) as a Fortran string.
+  function mpmc_f_string(p) result(s)
+    type(c_ptr), intent(in) :: p
+    character(len=:), allocatable :: s
+    s = f_string(p)
+  end function mpmc_f_string
+
+  !> The table index of the model called name (MPMC_ERR_ARG when there is none).
+  function mpmc_model_find(name, model) result(ierr)
+    character(*), intent(in) :: name
+    integer(c_int), intent(out) :: model
+    integer(c_int) :: ierr
+    ierr = mpmc_model_find_c(mpmc_c_str(name), model)
+  end function mpmc_model_find
+
+  !> Add a material of the named model from its parameters par(1:nstore), in the table's
+  !> order and units (mpmc_model_get_param); NaN takes an optional parameter's default.
+  function mpmc_sim_add_material(sim, model, par, id) result(ierr)
+    type(mpmc_sim), intent(in) :: sim
+    character(*), intent(in) :: model
+    real(c_double), intent(in) :: par(:)
+    integer(c_int), intent(out) :: id
+    integer(c_int) :: ierr
+    ierr = mpmc_sim_add_material_c(sim, mpmc_c_str(model), par, int(size(par), c_int), id)
+  end function mpmc_sim_add_material
 
   ! ---- errors ---------------------------------------------------------------------------
 

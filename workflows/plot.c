@@ -43,7 +43,7 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
       mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
     return -1;
   int plastic = 0;
-  for (int i = 0; i < sc->nmat; ++i) plastic |= sc->mats[i].model == WF_MODEL_HENCKY_J2;
+  for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
   if (plastic && mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
   *has_eps = eps != NULL;
   const int d = sc->dim;

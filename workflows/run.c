@@ -198,15 +198,7 @@ static int build(wf_run *w) {
   WF_TRY(w, mpmc_sim_set_sort_interval(sim, sc->sort_interval), "sort_interval");
   for (int i = 0; i < sc->nmat; ++i) {
     wf_material *m = &sc->mats[i];
-    int e = 0;
-    switch (m->model) {
-      case WF_MODEL_HENCKY_J2:
-        e = mpmc_sim_add_material_hencky_j2(sim, m->E, m->nu, m->rho, m->kappa_p, m->kappa_r, m->eta, &m->id);
-        break;
-      case WF_MODEL_HENCKY: e = mpmc_sim_add_material_hencky(sim, m->E, m->nu, m->rho, &m->id); break;
-      case WF_MODEL_NEO_HOOKEAN: e = mpmc_sim_add_material_neo_hookean(sim, m->E, m->nu, m->rho, &m->id); break;
-      default: e = mpmc_sim_add_material_newtonian(sim, m->K, m->mu, m->rho, &m->id); break;
-    }
+    const int e = mpmc_sim_add_material(sim, wf_model_name(m->model), m->par, m->npar, &m->id);
     WF_TRY(w, e, "materials.%s", m->name);
   }
   for (int i = 0; i < sc->nbody; ++i) {
@@ -255,7 +247,7 @@ static void log_plan(const wf_run *w) {
   const wf_scene *sc = &w->sc;
   int np = 0, plastic = 0, gmsh = 0, damping = 0, tractions = 0, walls = 0, srf = 0;
   if (w->sim) mpmc_sim_get_num_particles(w->sim, &np);
-  for (int i = 0; i < sc->nmat; ++i) plastic |= sc->mats[i].model == WF_MODEL_HENCKY_J2;
+  for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
   for (int i = 0; i < sc->nbody; ++i) gmsh |= sc->bodies[i].type == WF_GEOM_GMSH;
   for (int i = 0; i < sc->nstage; ++i) {
     damping |= sc->stages[i].damping > 0;
@@ -273,7 +265,7 @@ static void log_plan(const wf_run *w) {
     snprintf(buf_ + l_, sizeof on - l_, "%s%s", l_ ? ", " : "", text); \
   } while (0)
   FEATURE(sc->fbar, "F-bar");
-  FEATURE(plastic, "plastic state (hencky_j2)");
+  FEATURE(plastic, "plastic state (eps_p)");
   FEATURE(gmsh, "gmsh seeding");
   FEATURE(damping, "local damping");
   FEATURE(walls > 0, "walls");
@@ -294,14 +286,20 @@ static void log_plan(const wf_run *w) {
   say(w, "kernels: %s", kernels_detail(kern));
   for (int i = 0; i < sc->nmat; ++i) {
     const wf_material *m = &sc->mats[i];
-    if (m->model == WF_MODEL_HENCKY_J2)
-      say(w, "material %s: hencky_j2 E = %g Pa, nu = %g, rho = %g kg/m^3, kappa_p = %g Pa, kappa_r = %g Pa, eta = %g",
-          m->name, m->E, m->nu, m->rho, m->kappa_p, m->kappa_r, m->eta);
-    else if (m->model == WF_MODEL_NEWTONIAN)
-      say(w, "material %s: newtonian K = %g Pa, mu = %g Pa s, rho = %g kg/m^3", m->name, m->K, m->mu, m->rho);
-    else
-      say(w, "material %s: %s E = %g Pa, nu = %g, rho = %g kg/m^3", m->name, wf_model_name(m->model), m->E,
-          m->nu, m->rho);
+    char line[512];
+    int l = snprintf(line, sizeof line, "material %s: %s", m->name, wf_model_name(m->model));
+    for (int k = 0; k < m->npar && l < (int)sizeof line; ++k) {
+      mpmc_param_info pi;
+      if (mpmc_model_get_param(m->model, k, &pi)) break;
+      if (pi.nwords > 0 && m->par[k] >= 0 && m->par[k] < pi.nwords)
+        l += snprintf(line + l, sizeof line - (size_t)l, "%s %s = %s", k ? "," : "", pi.name,
+                      pi.words[(int)m->par[k]]);
+      else
+        l += snprintf(line + l, sizeof line - (size_t)l, "%s %s = %g%s%s", k ? "," : "", pi.name,
+                      m->par[k], pi.unit[0] && strcmp(pi.unit, "1") ? " " : "",
+                      strcmp(pi.unit, "1") ? pi.unit : "");
+    }
+    say(w, "%s", line);
   }
   for (int i = 0; i < sc->nstage; ++i) {
     const wf_stage *s = &sc->stages[i];
@@ -400,8 +398,8 @@ static int stage_setup(wf_run *w, int i) {
     WF_TRY(w, e, "stages.%d.tractions", i);
   }
   if (s->strength_reduction > 0 && s->strength_reduction != w->strength) {
-    /* the factor is absolute: divide by its ratio to the one in force */
-    WF_TRY(w, mpmc_sim_reduce_strength(sim, -1, s->strength_reduction / w->strength),
+    /* the factor is absolute: the strengths as given divided by it */
+    WF_TRY(w, mpmc_sim_set_strength_reduction(sim, -1, s->strength_reduction),
            "stages.%d.strength_reduction", i);
     w->strength = s->strength_reduction;
   }

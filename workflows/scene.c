@@ -582,14 +582,104 @@ static int apply_override(wf_node *root, const char *arg, const char *origin, ch
 
 /* ---- the scene schema ------------------------------------------------------------------ */
 static const char *const basis_words[] = {"linear", "ugimp", "bspline2", "bspline3", NULL};
-static const char *const model_words[] = {"hencky_j2", "hencky", "neo_hookean", "newtonian", NULL};
 static const char *const wall_kind_words[] = {"fixed", "slip", "separable", NULL};
 static const char *const axis_words[] = {"x", "y", "z", NULL};
 static const char *const face_words[] = {"x_lo", "x_hi", "y_lo", "y_hi", "z_lo", "z_hi", NULL};
 static const char *const solver_words[] = {"auto", "newton", "kinsol", NULL};
 
 const char *wf_basis_name(int b) { return b >= 0 && b < 4 ? basis_words[b] : "?"; }
-const char *wf_model_name(int m) { return m >= 0 && m < 4 ? model_words[m] : "?"; }
+const char *wf_model_name(int m) {
+  mpmc_model_info mi;
+  return mpmc_model_get_info(m, &mi) ? "?" : mi.name;
+}
+
+/* The models a scene may name: those of the library's table that need no function. */
+static int scene_models(const char **words, int cap) {
+  int n = 0, nm = 0;
+  mpmc_model_count(&nm);
+  for (int k = 0; k < nm && n < cap - 1; ++k) {
+    mpmc_model_info mi;
+    if (!mpmc_model_get_info(k, &mi) && !mi.needs_function) words[n++] = mi.name;
+  }
+  words[n] = NULL;
+  return n;
+}
+
+/* One material: its keys are the model's parameters in the library's table (names, units,
+ * ranges, defaults, aliases and "must not exceed" rules), so the scene, `mpmc check` and
+ * the library validate alike; messages name the file, line and key. */
+static int read_material(rd *r, const wf_node *mn, const char *path, wf_material *m) {
+  const char *words[WF_MAX_MODELS + 1];
+  scene_models(words, WF_MAX_MODELS + 1);
+  int w;
+  if (get_enum(r, mn, path, "model", 1, 0, words, &w)) return -1;
+  if (mpmc_model_find(words[w], &m->model)) return fail_at(r, mn, path, "unknown model");
+  mpmc_model_info mi;
+  mpmc_model_get_info(m->model, &mi);
+  const char *keys[MPMC_MAX_PARAMS + 8];
+  mpmc_param_info pi[MPMC_MAX_PARAMS + 8];
+  int nk = 0;
+  keys[nk++] = "model";
+  for (int k = 0; k < mi.nparam && k < MPMC_MAX_PARAMS + 6; ++k) {
+    mpmc_model_get_param(m->model, k, &pi[k]);
+    keys[nk++] = pi[k].name;
+  }
+  keys[nk] = NULL;
+  if (check_map(r, mn, path, keys)) return -1;
+  m->npar = mi.nstore;
+  char full[512];
+  for (int k = 0; k < mi.nstore; ++k) m->par[k] = NAN;
+  /* aliases first: su gives kappa_p = sqrt(3) su, unless kappa_p is given too */
+  for (int k = mi.nstore; k < mi.nparam; ++k) {
+    const mpmc_param_info *a = &pi[k];
+    const wf_node *an = map_get(mn, a->name);
+    if (!an) continue;
+    join(full, sizeof full, path, a->name);
+    if (map_get(mn, pi[a->alias_of].name))
+      return fail_at(r, an, full, "give %s or %s, not both", pi[a->alias_of].name, a->name);
+    const range g = {a->lo, a->hi, a->lo_open, a->hi_open};
+    double v;
+    if (get_num(r, mn, path, a->name, 1, 0, g, &v)) return -1;
+    m->par[a->alias_of] = a->scale * v;
+  }
+  for (int k = 0; k < mi.nstore; ++k) {
+    const mpmc_param_info *q = &pi[k];
+    if (!isnan(m->par[k])) continue; /* given by its alias */
+    const wf_node *qn = map_get(mn, q->name);
+    join(full, sizeof full, path, q->name);
+    if (!qn && !q->optional) {
+      char alias[64] = "";
+      for (int a = mi.nstore; a < mi.nparam; ++a)
+        if (pi[a].alias_of == k) snprintf(alias, sizeof alias, " (or %s)", pi[a].name);
+      return fail_at(r, mn, full, "required key is missing%s: %s [%s]", alias, q->doc, q->unit);
+    }
+    if (!qn) continue; /* the library's default */
+    if (q->nwords > 0) {
+      int c;
+      if (get_enum(r, mn, path, q->name, 1, 0, q->words, &c)) return -1;
+      m->par[k] = c;
+      continue;
+    }
+    const range g = {q->lo, q->hi, q->lo_open, q->hi_open};
+    if (get_num(r, mn, path, q->name, 1, 0, g, &m->par[k])) return -1;
+  }
+  /* defaults as the library takes them, then the "must not exceed" rules */
+  for (int k = 0; k < mi.nstore; ++k)
+    if (isnan(m->par[k]) && pi[k].optional)
+      m->par[k] = pi[k].default_of >= 0 ? m->par[pi[k].default_of] : pi[k].def;
+  for (int k = 0; k < mi.nstore; ++k) {
+    const int t = pi[k].at_most;
+    if (t < 0 || !(m->par[k] > m->par[t])) continue;
+    const char *key = pi[k].name;
+    for (int a = mi.nstore; a < mi.nparam; ++a)
+      if (pi[a].alias_of == k && map_get(mn, pi[a].name)) key = pi[a].name;
+    const wf_node *kn = map_get(mn, key);
+    join(full, sizeof full, path, key);
+    return fail_at(r, kn ? kn : mn, full, "must not exceed %s = %g (got %g)", pi[t].name,
+                   m->par[t], m->par[k]);
+  }
+  return 0;
+}
 
 static int read_materials(rd *r, const wf_node *root, wf_scene *sc) {
   const wf_node *ms = map_get(root, "materials");
@@ -599,49 +689,12 @@ static int read_materials(rd *r, const wf_node *root, wf_scene *sc) {
   sc->nmat = ms->n;
   sc->mats = calloc((size_t)ms->n, sizeof *sc->mats);
   if (!sc->mats) return fail_at(r, ms, "materials", "out of memory");
-  static const char *const keys[] = {"model", "E", "nu", "rho", "kappa_p", "kappa_r", "eta", "su", "su_r",
-                                     "K", "mu", NULL};
   for (int i = 0; i < ms->n; ++i) {
     wf_material *m = &sc->mats[i];
-    const wf_node *mn = ms->items[i];
     char path[256];
     snprintf(path, sizeof path, "materials.%s", ms->keys[i]);
     snprintf(m->name, sizeof m->name, "%s", ms->keys[i]);
-    if (check_map(r, mn, path, keys)) return -1;
-    if (get_enum(r, mn, path, "model", 1, 0, model_words, &m->model)) return -1;
-    if (get_num(r, mn, path, "rho", 1, 0, POS, &m->rho)) return -1;
-    if (m->model == WF_MODEL_NEWTONIAN) {
-      if (get_num(r, mn, path, "K", 1, 0, POS, &m->K) || get_num(r, mn, path, "mu", 0, 0, NONNEG, &m->mu))
-        return -1;
-      continue;
-    }
-    const range nu_r = {0, 0.5, 0, 1};
-    if (get_num(r, mn, path, "E", 1, 0, POS, &m->E) || get_num(r, mn, path, "nu", 1, 0, nu_r, &m->nu))
-      return -1;
-    if (m->model != WF_MODEL_HENCKY_J2) continue;
-    /* Strength: kappa is the von Mises equivalent stress q = sqrt(3/2)|dev tau| at yield.
-     * su (undrained shear strength, plane strain / Tresca-matched) gives kappa = sqrt(3) su. */
-    const int has_k = map_get(mn, "kappa_p") != NULL, has_su = map_get(mn, "su") != NULL;
-    char full[512];
-    join(full, sizeof full, path, has_k ? "su" : "kappa_p");
-    if (has_k && has_su) return fail_at(r, map_get(mn, "su"), full, "give kappa_p/kappa_r or su/su_r, not both");
-    if (has_su) {
-      double su, sur;
-      if (get_num(r, mn, path, "su", 1, 0, POS, &su)) return -1;
-      if (get_num(r, mn, path, "su_r", 0, su, POS, &sur)) return -1;
-      m->kappa_p = sqrt(3.0) * su;
-      m->kappa_r = sqrt(3.0) * sur;
-      join(full, sizeof full, path, "su_r");
-      if (sur > su) return fail_at(r, map_get(mn, "su_r"), full, "must not exceed su = %g (got %g)", su, sur);
-    } else {
-      if (get_num(r, mn, path, "kappa_p", 1, 0, POS, &m->kappa_p)) return -1;
-      if (get_num(r, mn, path, "kappa_r", 0, m->kappa_p, POS, &m->kappa_r)) return -1;
-      join(full, sizeof full, path, "kappa_r");
-      if (m->kappa_r > m->kappa_p)
-        return fail_at(r, map_get(mn, "kappa_r"), full, "must not exceed kappa_p = %g (got %g)",
-                       m->kappa_p, m->kappa_r);
-    }
-    if (get_num(r, mn, path, "eta", 0, 0, NONNEG, &m->eta)) return -1;
+    if (read_material(r, ms->items[i], path, m)) return -1;
   }
   return 0;
 }
@@ -1081,7 +1134,7 @@ static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
   sc->nsnapplot = ls->n;
   static const char *const keys[] = {"stage", "times", "color", "range", NULL};
   int plastic = 0;
-  for (int i = 0; i < sc->nmat; ++i) plastic |= sc->mats[i].model == WF_MODEL_HENCKY_J2;
+  for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
   for (int k = 0; k < ls->n; ++k) {
     wf_snapplot *sp = &sc->snapplots[k];
     const wf_node *n = ls->items[k];
@@ -1092,7 +1145,7 @@ static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
     if (get_enum(r, n, p, "color", 0, WF_COLOR_MEAN_STRESS, wf_color_names, &sp->color)) return -1;
     join(full, sizeof full, p, "color");
     if (sp->color == WF_COLOR_EPS_P && !plastic)
-      return fail_at(r, map_get(n, "color"), full, "eps_p needs a plastic (hencky_j2) material");
+      return fail_at(r, map_get(n, "color"), full, "eps_p needs a plastic material (hencky_j2, mohr_coulomb, drucker_prager)");
     sp->has_range = map_get(n, "range") != NULL;
     if (get_vec(r, n, p, "range", 0, 2, ANY, sp->range)) return -1;
     join(full, sizeof full, p, "range");

@@ -38,13 +38,19 @@ wf_node *wf_yaml_load(const char *path, char *msg, size_t len);
 const wf_node *wf_map_get(const wf_node *map, const char *key);
 
 /* ---- the scene as read (scene.c) ------------------------------------------------- */
-typedef enum { WF_MODEL_HENCKY_J2, WF_MODEL_HENCKY, WF_MODEL_NEO_HOOKEAN, WF_MODEL_NEWTONIAN } wf_model;
+#define WF_MAX_MODELS 32
 typedef struct {
   char name[WF_NAME];
-  int model;
-  double E, nu, rho, kappa_p, kappa_r, eta, K, mu;
+  int model;                    /* index in the library's model table (mpmc_model_*)     */
+  int npar;                     /* the model's stored parameters                        */
+  double par[MPMC_MAX_PARAMS];  /* in the table's order and units, defaults filled      */
   int id; /* in the simulation */
 } wf_material;
+/* 1 if the model keeps a plastic strain per point */
+static inline int wf_model_plastic(int model) {
+  mpmc_model_info mi;
+  return !mpmc_model_get_info(model, &mi) && mi.plastic;
+}
 
 typedef enum { WF_GEOM_BOX, WF_GEOM_POLYGON, WF_GEOM_GMSH } wf_geom_type;
 typedef struct {

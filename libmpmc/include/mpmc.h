@@ -117,7 +117,11 @@ typedef enum {
   MPMC_FIELD_EPS_P = 8,    /* [1] equivalent plastic strain (plastic materials only) */
   MPMC_FIELD_FORCE = 9,    /* [dim] external force on the particle (tractions)      */
   MPMC_FIELD_X0 = 10,      /* [dim] initial position                                 */
-  MPMC_FIELD_COUNT = 11
+  MPMC_FIELD_REGION = 11,  /* [1] where the last return mapping went (Mohr-Coulomb and
+                              Drucker-Prager only): 0 elastic, 1 plane (cone), 2 edge in
+                              triaxial compression, 3 in extension, 4 apex, 5 tension
+                              cut-off, 6 and 7 its edges and corners (docs/materials.md) */
+  MPMC_FIELD_COUNT = 12
 } mpmc_field;
 
 /* The phases of a step, as mpmc_stats.phase_seconds counts their wall time. */
@@ -191,14 +195,72 @@ int mpmc_sim_add_material_hencky_j2(mpmc_sim sim, double E, double nu, double rh
  * as in plane-strain shear; docs/materials.md). */
 int mpmc_sim_add_material_hencky_j2_su(mpmc_sim sim, double E, double nu, double rho,
                                        double su_p, double su_r, double eta, int *id);
+/* Hencky elasticity + Mohr-Coulomb plasticity (drained frictional soil): cohesion c [Pa],
+ * friction and dilation angles phi, psi [deg], residual values c_r, phi_r, psi_r (NAN: the
+ * peak value) reached exponentially with the accumulated plastic deviatoric strain at rate
+ * eta, tension cut-off sigma_t [Pa] (INFINITY: none).  docs/materials.md. */
+int mpmc_sim_add_material_mohr_coulomb(mpmc_sim sim, double E, double nu, double rho, double c,
+                                       double phi, double psi, double c_r, double phi_r,
+                                       double psi_r, double eta, double sigma_t, int *id);
+/* The smooth cone matched to Mohr-Coulomb's c, phi (and psi) at its compression meridian,
+ * its extension meridian or its plane-strain strength. */
+typedef enum {
+  MPMC_DP_MATCH_COMPRESSION = 0,
+  MPMC_DP_MATCH_EXTENSION = 1,
+  MPMC_DP_MATCH_PLANE_STRAIN = 2
+} mpmc_dp_match;
+int mpmc_sim_add_material_drucker_prager(mpmc_sim sim, double E, double nu, double rho, double c,
+                                         double phi, double psi, double c_r, double phi_r,
+                                         double psi_r, double eta, double sigma_t, int match,
+                                         int *id);
 /* The paper's strength reduction factor (landslide trigger), for mpmc_sim_reduce_strength. */
 #define MPMC_DEFAULT_STRENGTH_REDUCTION 1.65
 /* Nearly incompressible Newtonian fluid: p = -K (J - 1), deviatoric 2 mu dev(D). */
 int mpmc_sim_add_material_newtonian(mpmc_sim sim, double K, double mu, double rho, int *id);
 int mpmc_sim_get_num_materials(const mpmc_sim sim, int *n);
-/* Divide the yield strengths (kappa_p and kappa_r) of a plastic material by factor;
- * material = -1 for every plastic material.  Accumulated plastic strain is kept. */
+/* Divide the strengths of a plastic material by factor (J2: kappa_p, kappa_r; Mohr-Coulomb
+ * and Drucker-Prager: c, tan phi, tan psi and the tension cut-off); material = -1 for every
+ * plastic material.  Factors compose.  Accumulated plastic strain is kept. */
 int mpmc_sim_reduce_strength(mpmc_sim sim, int material, double factor);
+/* Set the total factor instead: the strengths as given divided by factor (1 restores). */
+int mpmc_sim_set_strength_reduction(mpmc_sim sim, int material, double factor);
+
+/* ---- the material model table ---------------------------------------------------- */
+/* Every model is described once (docs/materials.md is generated from the same table by
+ * `mpmc models --markdown`): its parameters with units, ranges and defaults. */
+typedef struct {
+  const char *name, *doc;
+  int nparam;         /* parameters, aliases included (mpmc_model_get_param)            */
+  int nstore;         /* parameters mpmc_sim_add_material takes: the first nstore       */
+  int plastic;        /* keeps an accumulated plastic strain per point                  */
+  int needs_function; /* added by its own constructor with the caller's function        */
+} mpmc_model_info;
+typedef struct {
+  const char *name, *unit, *doc;
+  double lo, hi;          /* valid range; lo_open/hi_open: the end is excluded          */
+  int lo_open, hi_open;
+  int optional;           /* may be omitted (NAN in mpmc_sim_add_material): then def,   */
+  double def;             /*   or parameter default_of's value when default_of >= 0     */
+  int default_of;
+  int at_most;            /* >= 0: must not exceed parameter at_most                    */
+  int alias_of;           /* >= 0: another way to give parameter alias_of, times scale  */
+  double scale;
+  int strength;           /* strength reduction: 0 kept, 1 divided, 2 tan divided (deg) */
+  int nwords;             /* > 0: a choice; the value is the index of one of words       */
+  const char *const *words;
+} mpmc_param_info;
+int mpmc_model_count(int *n);
+int mpmc_model_find(const char *name, int *model);
+int mpmc_model_get_info(int model, mpmc_model_info *info);
+int mpmc_model_get_param(int model, int k, mpmc_param_info *info);
+/* Add a material of the named model from its first nstore parameters in the table's order
+ * and units (NAN: the default of an optional one). */
+int mpmc_sim_add_material(mpmc_sim sim, const char *model, const double *par, int npar, int *id);
+/* A material's model, current (strength-reduced) parameters and reduction factor; par holds
+ * MPMC_MAX_PARAMS values (any may be NULL). */
+#define MPMC_MAX_PARAMS 16
+int mpmc_sim_get_material(const mpmc_sim sim, int material, int *model, double *par,
+                          double *factor);
 
 /* ---- material points ------------------------------------------------------- */
 /* Copies n points: x[n*dim] positions, volume[n] volumes (per unit thickness in 2D).
@@ -374,6 +436,32 @@ int mpmc_sim_add_material_user(mpmc_sim sim, mpmc_user_stress_fn fn, void *data,
  * user material with the most state); the points of `material` use the first entries of
  * their rows.  Valid until points are added. */
 int mpmc_sim_get_user_state(mpmc_sim sim, int material, double **state, int *nstate);
+
+/* ---- user yield surfaces (return_cpp.c) ------------------------------------------- */
+/* A yield surface the library returns to (closest-point projection on Hencky elasticity):
+ * at the Kirchhoff stress tau (Voigt xx yy zz yz xz xy, tensor components) and the hardening
+ * variable alpha (the accumulated plastic multiplier, alpha = alpha_n + dgamma; kept per
+ * point as eps_p), the function fills every field.  Derivatives are tensor derivatives in
+ * Voigt order: for f = tau:tau / 2, dfdtau = tau (shear entries tau_yz, not 2 tau_yz);
+ * drdtau[6 i + j] = d r_i / d tau_j as fourth-order tensor components, minor-symmetric. */
+typedef struct {
+  double f;            /* yield function [Pa]; <= 0 inside                            */
+  double dfdtau[6];    /* df/dtau                                                     */
+  double dfdalpha;     /* df/dalpha [Pa]                                              */
+  double r[6];         /* flow direction dg/dtau (associated: r = dfdtau)             */
+  double drdtau[36];   /* dr/dtau [1/Pa]                                              */
+  double drdalpha[6];  /* dr/dalpha                                                   */
+} mpmc_yield_eval;
+/* Returns 0, or non-zero to stop the step with MPMC_ERR_SOLVER.  Called from several
+ * threads at once. */
+typedef int (*mpmc_yield_fn)(void *data, const double *tau, double alpha, mpmc_yield_eval *out);
+/* Hencky elasticity (E [Pa], nu, rho [kg/m^3]) with the yield surface fn: the library returns
+ * to it (Newton on (tau, dgamma), KINSOL as the fallback, LAPACK loaded at the first plastic
+ * point).  A failed return names the point and, when the check finds one, the function's
+ * wrong derivative.  After mpmc_sim_checkpoint_read: mpmc_sim_set_material_yield_fn. */
+int mpmc_sim_add_material_user_yield(mpmc_sim sim, mpmc_yield_fn fn, void *data, double E,
+                                     double nu, double rho, int *id);
+int mpmc_sim_set_material_yield_fn(mpmc_sim sim, int material, mpmc_yield_fn fn, void *data);
 
 /* ---- the staged workflow (workflows/, library libmpmc_workflow) ---------------------- */
 /* Run a YAML scene: the same as `mpmc run scene --out outdir --set ...`.  overrides are

@@ -22,7 +22,7 @@
 #include "sets.h"
 
 #define CKPT_FORMAT "libmpmc-checkpoint"
-#define CKPT_VERSION 1
+#define CKPT_VERSION 2
 #define CKPT_CHECKSUM "checksum_fnv1a64"
 
 /* ---- small HDF5 helpers --------------------------------------------------------------- */
@@ -151,48 +151,55 @@ static int read_config(hid_t f, mpmc_sim sim) {
 
 /* ---- block: materials ------------------------------------------------------------------------ */
 
-#define NPARAM 14 /* rho E nu K G lambda kappa_p kappa_r eta mu solid plastic nstate wave */
+/* Per material: its model's name, its stored parameters as given (par0) and the strength
+ * reduction factor applied (the current parameters follow from both), and for user
+ * materials nothing more (the caller re-attaches the function).  Rows of MPMC_MAX_PARAM. */
+#define NPARAM MPMC_MAX_PARAM
+#define NAME_LEN 32
 
 static int write_materials(hid_t f, const mpmc_sim sim) {
   const int nm = sim->nmat;
-  double *par = malloc(sizeof(double) * NPARAM * (size_t)(nm > 0 ? nm : 1));
-  int *kind = malloc(sizeof(int) * (size_t)(nm > 0 ? nm : 1));
-  herr_t st = par && kind ? 0 : -1;
+  const size_t nr = (size_t)(nm > 0 ? nm : 1);
+  double *par = calloc(NPARAM * nr, sizeof(double)), *srm = calloc(nr, sizeof(double));
+  char *names = calloc(nr, NAME_LEN);
+  herr_t st = par && srm && names ? 0 : -1;
   for (int i = 0; i < nm && st == 0; ++i) {
     const mpmc_material *m = &sim->mats[i];
-    const double v[NPARAM] = {m->rho,     m->E,       m->nu, m->K,  m->G,     m->lambda,
-                              m->kappa_p, m->kappa_r, m->eta, m->mu, m->solid, m->plastic,
-                              m->user_nstate, m->user_wave_speed};
-    memcpy(par + (size_t)i * NPARAM, v, sizeof v);
-    kind[i] = m->kind;
+    memcpy(par + (size_t)i * NPARAM, m->par0, sizeof m->par0);
+    srm[i] = m->srm;
+    snprintf(names + (size_t)i * NAME_LEN, NAME_LEN, "%s", m->model->name);
   }
   hid_t g = st == 0 ? H5Gcreate2(f, "materials", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT) : -1;
   if (g < 0) st = -1;
   if (st == 0) {
     st |= mpmc_h5_attr_write(g, "count", H5T_NATIVE_INT, 1, &nm);
-    st |= mpmc_h5_dataset_write(g, "kind", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)nm, 0, kind);
     st |= mpmc_h5_dataset_write(g, "params", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)nm,
                                 NPARAM, par);
-    st |= mpmc_h5_attr_write_string(
-        g, "params_columns",
-        "rho E nu K G lambda kappa_p kappa_r eta mu solid plastic user_nstate user_wave_speed");
+    st |= mpmc_h5_dataset_write(g, "strength_reduction", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                                (size_t)nm, 0, srm);
+    st |= mpmc_h5_dataset_write(g, "model", H5T_STD_I8LE, H5T_NATIVE_CHAR, (size_t)nm, NAME_LEN,
+                                names);
   }
   if (g >= 0) H5Gclose(g);
   free(par);
-  free(kind);
+  free(srm);
+  free(names);
   return st < 0 ? -1 : 0;
 }
 
 /* A restored user material until the caller re-attaches its function. */
 static int unattached_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
-  (void)mat;
   (void)dt;
   return MPMC_ERROR(sim->ctx, MPMC_ERR_STATE,
-                    "user material %d was restored from a checkpoint without its function: "
-                    "call mpmc_sim_set_material_user_fn first",
-                    id);
+                    "%s material %d was restored from a checkpoint without its function: "
+                    "call %s first",
+                    mat->model->name, id,
+                    mat->model == mpmc_model_named("user") ? "mpmc_sim_set_material_user_fn"
+                                                            : "mpmc_sim_set_material_yield_fn");
 }
-static double unattached_wave_speed(const mpmc_material *m) { return m->user_wave_speed; }
+static double unattached_wave_speed(const mpmc_material *m) {
+  return m->model->ops->wave_speed(m);
+}
 static const mpmc_material_ops ops_unattached = {"user (unattached)", unattached_update,
                                                  unattached_wave_speed, 0, 0};
 
@@ -205,42 +212,51 @@ static int read_materials(hid_t f, mpmc_sim sim) {
     H5Gclose(g);
     return MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /materials: bad count %d", nm);
   }
-  double *par = malloc(sizeof(double) * NPARAM * (size_t)(nm > 0 ? nm : 1));
-  int *kind = malloc(sizeof(int) * (size_t)(nm > 0 ? nm : 1));
-  sim->mats = calloc((size_t)(nm > 0 ? nm : 1), sizeof *sim->mats);
-  herr_t st = par && kind && sim->mats ? 0 : -1;
-  if (st == 0) st |= read_dataset(g, "kind", H5T_NATIVE_INT, (size_t)nm, 0, kind);
+  const size_t nr = (size_t)(nm > 0 ? nm : 1);
+  double *par = calloc(NPARAM * nr, sizeof(double)), *srm = calloc(nr, sizeof(double));
+  char *names = calloc(nr, NAME_LEN);
+  sim->mats = calloc(nr, sizeof *sim->mats);
+  herr_t st = par && srm && names && sim->mats ? 0 : -1;
   if (st == 0) st |= read_dataset(g, "params", H5T_NATIVE_DOUBLE, (size_t)nm, NPARAM, par);
+  if (st == 0) st |= read_dataset(g, "strength_reduction", H5T_NATIVE_DOUBLE, (size_t)nm, 0, srm);
+  if (st == 0) st |= read_dataset(g, "model", H5T_NATIVE_CHAR, (size_t)nm, NAME_LEN, names);
   H5Gclose(g);
   int err = st < 0 ? MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
-                                "checkpoint /materials: kind/params datasets missing or not [%d][%d]",
+                                "checkpoint /materials: model/params/strength_reduction datasets "
+                                "missing or not [%d][%d]",
                                 nm, NPARAM)
                    : MPMC_SUCCESS;
-  sim->capmat = nm > 0 ? nm : 1;
+  sim->capmat = (int)nr;
   for (int i = 0; i < nm && !err; ++i) {
     mpmc_material *m = &sim->mats[i];
-    const double *v = par + (size_t)i * NPARAM;
-    m->kind = kind[i];
-    m->rho = v[0], m->E = v[1], m->nu = v[2], m->K = v[3], m->G = v[4], m->lambda = v[5];
-    m->kappa_p = v[6], m->kappa_r = v[7], m->eta = v[8], m->mu = v[9];
-    m->solid = (int)v[10], m->plastic = (int)v[11];
-    m->user_nstate = (int)v[12], m->user_wave_speed = v[13];
-    switch (kind[i]) {
-      case MPMC_MAT_NEO_HOOKEAN: m->ops = &mpmc_ops_neo_hookean; break;
-      case MPMC_MAT_HENCKY: m->ops = &mpmc_ops_hencky; break;
-      case MPMC_MAT_HENCKY_J2: m->ops = &mpmc_ops_hencky_j2; break;
-      case MPMC_MAT_NEWTONIAN: m->ops = &mpmc_ops_newtonian; break;
-      case MPMC_MAT_USER: m->ops = &ops_unattached; break;
-      default:
-        err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint material %d: unknown kind %d", i,
-                         kind[i]);
+    char *name = names + (size_t)i * NAME_LEN;
+    name[NAME_LEN - 1] = 0;
+    m->model = mpmc_model_named(name);
+    if (!m->model) {
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint material %d: unknown model '%s'", i,
+                       name);
+      break;
     }
-    if (!err && !(isfinite(m->rho) && m->rho > 0))
-      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint material %d: density %g", i, m->rho);
+    memcpy(m->par0, par + (size_t)i * NPARAM, sizeof m->par0);
+    m->srm = srm[i];
+    m->ops = (m->model->flags & MPMC_MODEL_CALLBACK) ? &ops_unattached : m->model->ops;
+    if (!(isfinite(m->srm) && m->srm > 0))
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint material %d: strength reduction %g", i,
+                       m->srm);
+    if (!err) {
+      /* the current parameters: par0 reduced by srm as mpmc_sim_set_strength_reduction does */
+      err = mpmc_material_restore(ctx, m);
+      if (err) {
+        char why[256];
+        snprintf(why, sizeof why, "%s", mpmc_context_last_error(ctx));
+        err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint material %d (%s): %s", i, name, why);
+      }
+    }
     if (!err) sim->nmat = i + 1;
   }
   free(par);
-  free(kind);
+  free(srm);
+  free(names);
   return err;
 }
 
@@ -254,13 +270,13 @@ int mpmc_sim_set_material_user_fn(mpmc_sim sim, int material, mpmc_user_stress_f
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(material >= 0 && material < sim->nmat, sim->ctx, MPMC_ERR_ARG,
              "material id %d does not exist (%d materials)", material, sim->nmat);
-  MPMC_CHECK(sim->mats[material].kind == MPMC_MAT_USER, sim->ctx, MPMC_ERR_ARG,
+  MPMC_CHECK(sim->mats[material].model == mpmc_model_named("user"), sim->ctx, MPMC_ERR_ARG,
              "material %d is a '%s' material, not a user material", material,
              sim->mats[material].ops->name);
   MPMC_CHECK(fn, sim->ctx, MPMC_ERR_ARG, "user material %d: stress function fn is NULL", material);
   sim->mats[material].user_fn = fn;
   sim->mats[material].user_data = data;
-  sim->mats[material].ops = &mpmc_ops_user;
+  sim->mats[material].ops = sim->mats[material].model->ops;
   return MPMC_SUCCESS;
 }
 
@@ -279,7 +295,8 @@ static const pfield pfields[] = {PF(x, 0, 1),     PF(x0, 0, 1),     PF(v, 0, 1),
                                  PF(m, 1, 1),     PF(vol0, 1, 1),   PF(J, 1, 1),
                                  PF(stress, 6, 1), PF(Jbar, 1, 0),  PF(be, 6, 0),
                                  PF(eps_p, 1, 0), PF(lp, 1, 0),     PF(force, 0, 0),
-                                 PF(cforce, 0, 0), PF(ustate, -1, 0), PF(Janc, 1, 0)};
+                                 PF(cforce, 0, 0), PF(ustate, -1, 0), PF(Janc, 1, 0),
+                                 PF(region, 1, 0)};
 #undef PF
 
 static double **pfield_ptr(mpmc_particles *p, const pfield *f) {

@@ -8,11 +8,37 @@
 
 /* in the sim's instruction set, four points at a time (stress_blocks.c) */
 static int hencky_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) {
-  return mpmc_kernels_stress_batch(sim, MPMC_MAT_HENCKY)(sim, mat, id, dt);
+  return mpmc_kernels_stress_batch(sim, MPMC_BATCH_HENCKY)(sim, mat, id, dt);
 }
 
 static double hencky_wave_speed(const mpmc_material *m) {
   return sqrt((m->K + 4.0 / 3.0 * m->G) / m->rho);
 }
 
-const mpmc_material_ops mpmc_ops_hencky = {"hencky", hencky_update, hencky_wave_speed, 1, 1};
+static const mpmc_material_ops ops = {"hencky", hencky_update, hencky_wave_speed, 1, 1};
+
+static const mpmc_param_desc params[] = {MPMC_PARAMS_ELASTIC};
+
+static int hencky_setup(mpmc_context ctx, mpmc_material *m) {
+  (void)ctx;
+  mpmc_material_elastic(m);
+  return MPMC_SUCCESS;
+}
+
+const mpmc_model mpmc_model_hencky = {
+    .name = "hencky",
+    .doc = "Hencky (logarithmic-strain) elasticity",
+    .nparam = 3,
+    .nstore = 3,
+    .param = params,
+    .flags = MPMC_MODEL_SOLID,
+    .setup = hencky_setup,
+    .ops = &ops};
+
+/**
+ * @brief Add a Hencky (logarithmic-strain) elastic material, tau = K tr(eps) 1 + 2G dev(eps).
+ */
+int mpmc_sim_add_material_hencky(mpmc_sim sim, double E, double nu, double rho, int *id) {
+  const double par[] = {E, nu, rho};
+  return mpmc_material_add(sim, &mpmc_model_hencky, par, id);
+}

@@ -191,7 +191,54 @@ static double j2_wave_speed(const mpmc_material *m) {
   return sqrt((m->K + 4.0 / 3.0 * m->G) / m->rho);
 }
 
-const mpmc_material_ops mpmc_ops_hencky_j2 = {"hencky_j2", j2_update, j2_wave_speed, 1, 1};
+static const mpmc_material_ops ops = {"hencky_j2", j2_update, j2_wave_speed, 1, 1};
+
+enum { E_, NU_, RHO_, KAPPA_P, KAPPA_R, ETA };
+static const mpmc_param_desc params[] = {
+    MPMC_PARAMS_ELASTIC,
+    MPMC_PARAM("kappa_p", "Pa", "peak strength (von Mises q at yield)", 0.0, INFINITY,
+               MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, 0.0, -1, -1),
+    MPMC_PARAM("kappa_r", "Pa", "residual strength", 0.0, INFINITY,
+               MPMC_PARAM_OPTIONAL | MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, NAN, KAPPA_P,
+               KAPPA_P),
+    MPMC_PARAM("eta", "1", "softening rate", 0.0, INFINITY,
+               MPMC_PARAM_OPTIONAL | MPMC_PARAM_HI_OPEN, 0.0, -1, -1),
+    MPMC_ALIAS("su", "Pa", "peak undrained shear strength (kappa_p = sqrt(3) su)", 0.0, INFINITY,
+               MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, KAPPA_P, 1.7320508075688772),
+    MPMC_ALIAS("su_r", "Pa", "residual undrained shear strength (kappa_r = sqrt(3) su_r)", 0.0,
+               INFINITY, MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, KAPPA_R, 1.7320508075688772)};
+
+static int j2_setup(mpmc_context ctx, mpmc_material *m) {
+  (void)ctx;
+  mpmc_material_elastic(m);
+  m->kappa_p = m->par[KAPPA_P];
+  m->kappa_r = m->par[KAPPA_R];
+  m->eta = m->par[ETA];
+  return MPMC_SUCCESS;
+}
+
+const mpmc_model mpmc_model_hencky_j2 = {
+    .name = "hencky_j2",
+    .doc = "Hencky elasticity, von Mises plasticity with exponential softening (undrained clay)",
+    .nparam = 8,
+    .nstore = 6,
+    .param = params,
+    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC,
+    .strength = {[KAPPA_P] = MPMC_SRM_DIVIDE, [KAPPA_R] = MPMC_SRM_DIVIDE},
+    .setup = j2_setup,
+    .ops = &ops};
+
+/**
+ * @brief Add Hencky elasticity with von Mises plasticity and exponential softening.
+ * @param kappa_p peak strength (von Mises equivalent stress q at yield) [Pa], > 0
+ * @param kappa_r residual strength [Pa], 0 < kappa_r <= kappa_p
+ * @param eta softening rate, >= 0 (0: perfect plasticity at kappa_p)
+ */
+int mpmc_sim_add_material_hencky_j2(mpmc_sim sim, double E, double nu, double rho, double kappa_p,
+                                    double kappa_r, double eta, int *id) {
+  const double par[] = {E, nu, rho, kappa_p, kappa_r, eta};
+  return mpmc_material_add(sim, &mpmc_model_hencky_j2, par, id);
+}
 
 /**
  * @brief Add Hencky-J2 with the strengths given as undrained shear strengths su.
@@ -209,11 +256,9 @@ int mpmc_sim_add_material_hencky_j2_su(mpmc_sim sim, double E, double nu, double
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(isfinite(su_p) && su_p > 0, ctx, MPMC_ERR_ARG,
-             "peak undrained shear strength su_p = %g must be > 0", su_p);
-  MPMC_CHECK(isfinite(su_r) && su_r > 0, ctx, MPMC_ERR_ARG,
-             "residual undrained shear strength su_r = %g must be > 0", su_r);
-  MPMC_CHECK(su_r <= su_p, ctx, MPMC_ERR_ARG,
-             "residual shear strength su_r = %g must not exceed peak shear strength su_p = %g",
+             "hencky_j2: peak undrained shear strength su_p = %g must be > 0", su_p);
+  MPMC_CHECK(isfinite(su_r) && su_r > 0 && su_r <= su_p, ctx, MPMC_ERR_ARG,
+             "hencky_j2: residual undrained shear strength su_r = %g must be in (0, su_p = %g]",
              su_r, su_p);
   const double s3 = sqrt(3.0);
   return mpmc_sim_add_material_hencky_j2(sim, E, nu, rho, s3 * su_p, s3 * su_r, eta, id);

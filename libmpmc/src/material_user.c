@@ -12,6 +12,8 @@
 
 #define MPMC_USER_NSTATE_MAX 4096
 
+extern const mpmc_model mpmc_model_user;
+
 /* Widen p->ustate rows to nstate columns for the current capacity, keeping every point's
  * existing values and zeroing the new columns (the documented initial state). */
 static int widen_state(mpmc_context ctx, mpmc_particles *p, int nstate) {
@@ -54,32 +56,17 @@ int mpmc_sim_add_material_user(mpmc_sim sim, mpmc_user_stress_fn fn, void *data,
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(fn, ctx, MPMC_ERR_ARG, "user material: stress function fn is NULL");
-  MPMC_CHECK(nstate >= 0 && nstate <= MPMC_USER_NSTATE_MAX, ctx, MPMC_ERR_ARG,
-             "user material: nstate = %d must be in [0, %d]", nstate, MPMC_USER_NSTATE_MAX);
-  MPMC_CHECK(isfinite(rho) && rho > 0, ctx, MPMC_ERR_ARG,
-             "user material: density rho = %g must be > 0", rho);
-  MPMC_CHECK(isfinite(wave_speed) && wave_speed > 0, ctx, MPMC_ERR_ARG,
-             "user material: wave_speed = %g must be > 0", wave_speed);
-  if (sim->nmat == sim->capmat) {
-    const int cap = sim->capmat ? 2 * sim->capmat : 4;
-    mpmc_material *a = realloc(sim->mats, sizeof *a * (size_t)cap);
-    MPMC_CHECK(a, ctx, MPMC_ERR_MEMORY, "cannot add a material");
-    sim->mats = a;
-    sim->capmat = cap;
+  const double par[] = {rho, wave_speed, nstate};
+  int mid;
+  MPMC_CALL(mpmc_material_add(sim, &mpmc_model_user, par, &mid));
+  const int err = widen_state(ctx, &sim->p, nstate);
+  if (err) {
+    sim->nmat--; /* not added after all */
+    return err;
   }
-  MPMC_CALL(widen_state(ctx, &sim->p, nstate));
-  mpmc_material m = {0};
-  m.kind = MPMC_MAT_USER;
-  m.ops = &mpmc_ops_user;
-  m.rho = rho;
-  m.user_fn = fn;
-  m.user_data = data;
-  m.user_nstate = nstate;
-  m.user_wave_speed = wave_speed;
-  sim->mats[sim->nmat] = m;
-  if (id) *id = sim->nmat;
-  sim->nmat++;
-  sim->prepared = 0;
+  sim->mats[mid].user_fn = fn;
+  sim->mats[mid].user_data = data;
+  if (id) *id = mid;
   return MPMC_SUCCESS;
 }
 
@@ -99,7 +86,7 @@ int mpmc_sim_get_user_state(mpmc_sim sim, int material, double **state, int *nst
   MPMC_CHECK(nstate, ctx, MPMC_ERR_ARG, "nstate pointer is NULL");
   MPMC_CHECK(material >= 0 && material < sim->nmat, ctx, MPMC_ERR_ARG,
              "material id %d does not exist (%d materials)", material, sim->nmat);
-  MPMC_CHECK(sim->mats[material].kind == MPMC_MAT_USER, ctx, MPMC_ERR_ARG,
+  MPMC_CHECK(sim->mats[material].model == &mpmc_model_user, ctx, MPMC_ERR_ARG,
              "material %d is a built-in '%s' material, not a user material", material,
              sim->mats[material].ops->name);
   *state = sim->p.nustate > 0 ? sim->p.ustate : NULL;
@@ -141,4 +128,30 @@ static int user_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt
 
 static double user_wave_speed(const mpmc_material *m) { return m->user_wave_speed; }
 
-const mpmc_material_ops mpmc_ops_user = {"user", user_update, user_wave_speed, 0, 0};
+static const mpmc_material_ops ops = {"user", user_update, user_wave_speed, 0, 0};
+
+static const mpmc_param_desc params[] = {
+    MPMC_PARAM("rho", "kg/m^3", "density", 0.0, INFINITY, MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN,
+               0.0, -1, -1),
+    MPMC_PARAM("wave_speed", "m/s", "p-wave speed for the stable time step", 0.0, INFINITY,
+               MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, 0.0, -1, -1),
+    MPMC_PARAM("nstate", "1", "state variables per point", 0.0, MPMC_USER_NSTATE_MAX, 0, 0.0, -1,
+               -1)};
+
+static int user_setup(mpmc_context ctx, mpmc_material *m) {
+  MPMC_CHECK(m->par[2] == floor(m->par[2]), ctx, MPMC_ERR_ARG,
+             "user: parameter nstate = %g must be a whole number", m->par[2]);
+  m->rho = m->par[0];
+  m->user_wave_speed = m->par[1];
+  m->user_nstate = (int)m->par[2];
+  return MPMC_SUCCESS;
+}
+
+const mpmc_model mpmc_model_user = {.name = "user",
+                                    .doc = "the caller's stress update (C or Fortran function)",
+                                    .nparam = 3,
+                                    .nstore = 3,
+                                    .param = params,
+                                    .flags = MPMC_MODEL_CALLBACK,
+                                    .setup = user_setup,
+                                    .ops = &ops};

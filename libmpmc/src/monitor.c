@@ -36,7 +36,7 @@
 static void signature(const mpmc_sim sim, double *sig) {
   for (int a = 0; a < 3; ++a) sig[a] = sim->gravity[a];
   double k = sim->nmat;
-  for (int m = 0; m < sim->nmat; ++m) k += sim->mats[m].kappa_p + 0.5 * sim->mats[m].kappa_r;
+  for (int m = 0; m < sim->nmat; ++m) k += sim->mats[m].srm; /* strength reductions */
   sig[3] = k;
   sig[4] = sim->p.n;
   double w = 0.0;
@@ -49,7 +49,7 @@ static void signature(const mpmc_sim sim, double *sig) {
 static double energy_density(const mpmc_material *m, const double *s, double J) {
   const double p = J * (s[0] + s[1] + s[2]) / 3.0;
   double e = p * p / (2.0 * m->K);
-  if (m->kind == MPMC_MAT_NEWTONIAN) return e; /* the viscous deviator stores nothing */
+  if (m->model->flags & MPMC_MODEL_FLUID) return e; /* the viscous deviator stores nothing */
   double ss = 0.0;
   for (int a = 0; a < 3; ++a) ss += (J * s[a] - p) * (J * s[a] - p);
   for (int a = 3; a < 6; ++a) ss += 2.0 * J * J * s[a] * s[a];
@@ -116,7 +116,7 @@ int mpmc_monitor_step(mpmc_sim sim) {
   const int d = sim->dim;
   const int64_t step = sim->stats.steps + 1; /* this step, counted from 1 */
   int energy = mo->factor >= 0.0 && !sim->bodies;
-  for (int m = 0; m < sim->nmat && energy; ++m) energy = sim->mats[m].kind != MPMC_MAT_USER;
+  for (int m = 0; m < sim->nmat && energy; ++m) energy = !(sim->mats[m].model->flags & MPMC_MODEL_CALLBACK);
   double sig[7];
   signature(sim, sig);
   int changed = mo->base_step <= 0 || step < mo->base_step;

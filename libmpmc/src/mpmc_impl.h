@@ -68,6 +68,7 @@ typedef struct {
                     last Jbar / J (transfer.h, mpmc_anchor)                          */
   double *be;    /* [n][6] elastic left Cauchy-Green (solid materials)            */
   double *eps_p; /* [n] equivalent plastic strain (plastic materials)             */
+  double *region;/* [n] where the last return went (frictional models, MPMC_MC_*)  */
   double *lp;    /* [n] uGIMP half-length, fixed at its initial value (uGIMP)      */
   double *force; /* [n][dim] external force (tractions)                           */
   double *cforce;/* [n][dim] contact force from rigid bodies (contact_barrier.c)   */
@@ -202,19 +203,11 @@ static inline double mpmc_grid_mass(const mpmc_grid *g, size_t i) {
   return g->node[i * MPMC_NREC];
 }
 
-/* ---- materials (material.c, material_*.c) ------------------------------------------- */
-typedef enum {
-  MPMC_MAT_NEO_HOOKEAN = 0,
-  MPMC_MAT_HENCKY = 1,
-  MPMC_MAT_HENCKY_J2 = 2,
-  MPMC_MAT_NEWTONIAN = 3,
-  MPMC_MAT_USER = 4
-} mpmc_material_kind;
-
+/* ---- materials: the model table (material_table.c) and one file per model ------------- */
 struct mpmc_sim_s;
 typedef struct mpmc_material_s mpmc_material;
 
-/* The material table: one file per model. */
+/* How a model updates its points. */
 typedef struct {
   const char *name;
   /* Update the stress of every point p with mat[p] == id from the relative deformation
@@ -230,27 +223,106 @@ typedef struct {
   int checks_stress;
 } mpmc_material_ops;
 
-struct mpmc_material_s {
-  int kind;
+/* A model's description (material_table.c lists them): its name, parameters with units and
+ * ranges, per-point state and strength-reduction rule.  The library's validation, the
+ * checkpoint, the scene reader, `mpmc check` and the docs' parameter table read it. */
+#define MPMC_MAX_PARAM 16
+_Static_assert(MPMC_MAX_PARAM == MPMC_MAX_PARAMS, "the public and the table's parameter limit");
+#define MPMC_RAD 0.017453292519943295 /* pi / 180: parameters in degrees to radians */
+typedef struct {
+  const char *name;      /* key in scenes and checkpoints                               */
+  const char *unit;      /* "Pa", "deg", "kg/m^3", "1", "Pa s"                          */
+  const char *doc;       /* one line                                                    */
+  double lo, hi;         /* valid range                                                 */
+  unsigned flags;        /* MPMC_PARAM_*                                                */
+  double def;            /* default when MPMC_PARAM_OPTIONAL (NAN: default_of's value)  */
+  int default_of;        /* default: the value of this parameter (-1: def)              */
+  int at_most;           /* must not exceed this parameter's value (-1: no such rule)   */
+  int alias_of;          /* an alternative way to give parameter alias_of, times scale  */
+  double scale;          /*   (not stored; -1: a parameter of its own)                  */
+  const char *const *words; /* a choice: the value is the index of the word             */
+} mpmc_param_desc;
+
+typedef struct mpmc_model_s {
+  const char *name;      /* model key in scenes and checkpoints ("hencky_j2")           */
+  const char *doc;       /* one line                                                    */
+  int nparam;            /* entries in param (stored ones first, then aliases)          */
+  int nstore;            /* stored parameters: par[0 .. nstore)                         */
+  const mpmc_param_desc *param;
+  unsigned flags;        /* MPMC_MODEL_*                                                */
+  int strength[MPMC_MAX_PARAM]; /* strength reduction: per stored parameter,
+                            MPMC_SRM_KEEP (0), MPMC_SRM_DIVIDE (a strength) or
+                            MPMC_SRM_TAN (an angle in degrees whose tangent is divided)   */
+  /* derive the material's constants from m->par (after validation; may add checks) */
+  int (*setup)(mpmc_context ctx, mpmc_material *m);
   const mpmc_material_ops *ops;
+} mpmc_model;
+
+enum { MPMC_PARAM_OPTIONAL = 1, MPMC_PARAM_LO_OPEN = 2, MPMC_PARAM_HI_OPEN = 4 };
+/* Table entries: a parameter in [lo, hi] (flags: open ends, optional with default def or,
+ * def_of >= 0, the value of parameter def_of; at_most >= 0: not above that parameter), an
+ * alias (another way to give parameter of, times scale), a choice among words (default the
+ * word numbered def). */
+#define MPMC_PARAM(nm, un, dc, lo_, hi_, fl, def_, def_of, at_most_)                          \
+  {.name = nm, .unit = un, .doc = dc, .lo = lo_, .hi = hi_, .flags = fl, .def = def_,         \
+   .default_of = def_of, .at_most = at_most_, .alias_of = -1, .scale = 1.0, .words = NULL}
+#define MPMC_ALIAS(nm, un, dc, lo_, hi_, fl, of, sc)                                          \
+  {.name = nm, .unit = un, .doc = dc, .lo = lo_, .hi = hi_, .flags = fl, .def = 0.0,          \
+   .default_of = -1, .at_most = -1, .alias_of = of, .scale = sc, .words = NULL}
+#define MPMC_CHOICE(nm, dc, w, def_)                                                          \
+  {.name = nm, .unit = "", .doc = dc, .lo = 0.0, .hi = 0.0, .flags = MPMC_PARAM_OPTIONAL,     \
+   .def = def_, .default_of = -1, .at_most = -1, .alias_of = -1, .scale = 1.0, .words = w}
+/* the solid models' first three parameters: E, nu, rho */
+#define MPMC_PARAMS_ELASTIC                                                                   \
+  MPMC_PARAM("E", "Pa", "Young's modulus", 0.0, INFINITY, MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, \
+             0.0, -1, -1),                                                                    \
+  MPMC_PARAM("nu", "1", "Poisson's ratio", 0.0, 0.5, MPMC_PARAM_HI_OPEN, 0.0, -1, -1),       \
+  MPMC_PARAM("rho", "kg/m^3", "density", 0.0, INFINITY,                                       \
+             MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, 0.0, -1, -1)
+/* E, nu, rho of m->par[0..2] to the elastic constants (material_table.c) */
+void mpmc_material_elastic(mpmc_material *m);
+enum {
+  MPMC_MODEL_SOLID = 1,     /* keeps b_e per point                                       */
+  MPMC_MODEL_PLASTIC = 2,   /* keeps eps_p per point                                     */
+  MPMC_MODEL_REGION = 4,    /* keeps the return region per point                         */
+  MPMC_MODEL_CALLBACK = 8,  /* needs the caller's function: added by its own constructor */
+  MPMC_MODEL_FLUID = 16     /* no elastic deviator (the energy check's density)          */
+};
+enum { MPMC_SRM_KEEP = 0, MPMC_SRM_DIVIDE = 1, MPMC_SRM_TAN = 2 };
+
+/* the table (material_table.c) */
+int mpmc_model_table_size(void);
+const mpmc_model *mpmc_model_at(int k);
+const mpmc_model *mpmc_model_named(const char *name);
+/* add a material of model from its stored parameters (validated against the table) */
+int mpmc_material_add(struct mpmc_sim_s *sim, const mpmc_model *model, const double *par,
+                      int *id);
+/* re-derive m's constants after par changed (strength reduction) */
+int mpmc_material_setup(mpmc_context ctx, mpmc_material *m);
+/* a material read back from a checkpoint: m->par0 validated, then reduced by m->srm */
+int mpmc_material_restore(mpmc_context ctx, mpmc_material *m);
+
+struct mpmc_material_s {
+  const mpmc_model *model;
+  const mpmc_material_ops *ops;             /* the model's (restored user materials:
+                                               unattached until re-attached)            */
+  double par[MPMC_MAX_PARAM];               /* stored parameters, strength reduced      */
+  double par0[MPMC_MAX_PARAM];              /* as given                                  */
+  double srm;                               /* strength reduction factor applied (1)    */
+  /* derived by the model's setup */
   double rho;
   double E, nu, K, G, lambda;               /* elastic constants                     */
   double kappa_p, kappa_r, eta;             /* J2 softening                          */
   double mu;                                /* fluid viscosity                       */
   int solid;                                /* needs be                              */
   int plastic;                              /* needs eps_p                           */
-  /* user material (material_user.c) */
+  /* user materials (material_user.c, material_user_yield.c) */
   mpmc_user_stress_fn user_fn;              /* the caller's stress update            */
+  mpmc_yield_fn yield_fn;                   /* the caller's yield surface            */
   void *user_data;                          /* handed back to user_fn                */
   int user_nstate;                          /* state variables it uses per point     */
   double user_wave_speed;                   /* p-wave speed for the stable time step */
 };
-
-extern const mpmc_material_ops mpmc_ops_neo_hookean;
-extern const mpmc_material_ops mpmc_ops_hencky;
-extern const mpmc_material_ops mpmc_ops_hencky_j2;
-extern const mpmc_material_ops mpmc_ops_newtonian;
-extern const mpmc_material_ops mpmc_ops_user;
 
 /* ---- walls (boundary.c) ------------------------------------------------------------ */
 typedef struct {
@@ -414,8 +486,9 @@ MPMC_KERNEL_PROTOTYPES(_avx512)
 #endif
 int mpmc_stress_update(struct mpmc_sim_s *sim, double dt);
 /* the sim's set of a material's update over blocks of four (stress_blocks.c), which the
- * material's ops->stress_update runs: model MPMC_MAT_NEO_HOOKEAN (mpmc_nh_batch),
- * MPMC_MAT_HENCKY (mpmc_hencky_batch) or MPMC_MAT_NEWTONIAN (mpmc_newtonian_batch) */
+ * material's ops->stress_update runs: MPMC_BATCH_NEO_HOOKEAN (mpmc_nh_batch),
+ * MPMC_BATCH_HENCKY (mpmc_hencky_batch) or MPMC_BATCH_NEWTONIAN (mpmc_newtonian_batch) */
+enum { MPMC_BATCH_NEO_HOOKEAN = 0, MPMC_BATCH_HENCKY = 1, MPMC_BATCH_NEWTONIAN = 2 };
 typedef int (*mpmc_stress_batch_fn)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                                     double dt);
 mpmc_stress_batch_fn mpmc_kernels_stress_batch(const struct mpmc_sim_s *sim, int model);
@@ -450,6 +523,5 @@ int mpmc_contact_check(struct mpmc_sim_s *sim);
 void mpmc_contact_step(struct mpmc_sim_s *sim, int begin);
 /* sets.c */
 void mpmc_sets_free(struct mpmc_sim_s *sim);
-int mpmc_material_validate_elastic(mpmc_context ctx, double E, double nu, double rho);
 
 #endif

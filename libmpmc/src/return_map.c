@@ -33,6 +33,9 @@ struct mpmc_rm_ws_s {
   SUNLinearSolver LS;
   rm_problem prob;
   int kinsol_ready;
+  /* other return maps' per-thread memory (mpmc_rm_ws_slot), freed with the workspace */
+  void *slot[MPMC_RM_NSLOT];
+  void (*slot_free[MPMC_RM_NSLOT])(void *);
 };
 
 /* per-simulation pool: one workspace per thread */
@@ -297,9 +300,21 @@ int mpmc_rm_ws_create(mpmc_rm_ws **ws) {
 
 void mpmc_rm_ws_destroy(mpmc_rm_ws **ws) {
   if (!ws || !*ws) return;
+  for (int k = 0; k < MPMC_RM_NSLOT; ++k)
+    if ((*ws)->slot[k] && (*ws)->slot_free[k]) (*ws)->slot_free[k]((*ws)->slot[k]);
   kinsol_free(*ws);
   free(*ws);
   *ws = NULL;
+}
+
+/**
+ * @brief The workspace's slot k (MPMC_RM_SLOT_*): a return map's own per-thread memory,
+ * created by the caller on first use and released by free_fn with the workspace.
+ */
+void **mpmc_rm_ws_slot(mpmc_rm_ws *ws, int k, void (*free_fn)(void *)) {
+  if (!ws || k < 0 || k >= MPMC_RM_NSLOT) return NULL;
+  ws->slot_free[k] = free_fn;
+  return &ws->slot[k];
 }
 
 int mpmc_rm_sim_workspaces(struct mpmc_sim_s *sim, int nthreads, mpmc_rm_ws ***ws) {

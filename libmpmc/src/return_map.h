@@ -159,6 +159,10 @@ int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, d
 
 /* The per-thread workspaces of a simulation (sim->solver_ws): makes sure there are
  * at least nthreads and returns them; freed by mpmc_return_map_free. */
+/* Slots of a workspace for the other return maps' per-thread memory (their KINSOL): the
+ * frictional models (return_mc.c) and the user yield surfaces (return_cpp.c). */
+enum { MPMC_RM_SLOT_MC = 0, MPMC_RM_SLOT_CPP = 1, MPMC_RM_NSLOT = 2 };
+void **mpmc_rm_ws_slot(mpmc_rm_ws *ws, int k, void (*free_fn)(void *));
 int mpmc_rm_sim_workspaces(struct mpmc_sim_s *sim, int nthreads, mpmc_rm_ws ***ws);
 
 /* stress_j2.c, one of the kernel files (mpmc_impl.h): the stress update of material id's

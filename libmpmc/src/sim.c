@@ -351,6 +351,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
     if (p->be)
       for (int k = 0; k < 6; ++k) p->be[q * 6 + k] = k < 3 ? 1.0 : 0.0;
     if (p->eps_p) p->eps_p[q] = 0.0;
+    if (p->region) p->region[q] = 0.0;
     if (p->lp) p->lp[q] = 0.5 * pow(volume[i], 1.0 / d);
     if (p->force)
       for (int a = 0; a < d; ++a) p->force[q * d + a] = 0.0;
@@ -377,10 +378,11 @@ int mpmc_sim_prepare(mpmc_sim sim) {
   mpmc_particles *p = &sim->p;
   const int d = sim->dim;
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "no grid set");
-  int solid = 0, plastic = 0;
+  int solid = 0, plastic = 0, region = 0;
   for (int i = 0; i < sim->nmat; ++i) {
     solid |= sim->mats[i].solid;
     plastic |= sim->mats[i].plastic;
+    region |= (sim->mats[i].model->flags & MPMC_MODEL_REGION) != 0;
   }
   if (p->cap == 0) MPMC_CALL(mpmc_particles_reserve(ctx, p, 64));
   if (solid) {
@@ -391,6 +393,7 @@ int mpmc_sim_prepare(mpmc_sim sim) {
     }
   }
   if (plastic) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->eps_p, 1, 0.0));
+  if (region) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->region, 1, 0.0));
   if (sim->fbar && !p->Jbar) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
     for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
@@ -456,12 +459,14 @@ static double **field_ptr(mpmc_sim sim, int field, int *ncomp) {
     case MPMC_FIELD_EPS_P: *ncomp = 1; return &p->eps_p;
     case MPMC_FIELD_FORCE: *ncomp = d; return &p->force;
     case MPMC_FIELD_X0: *ncomp = d; return &p->x0;
+    case MPMC_FIELD_REGION: *ncomp = 1; return &p->region;
     default: return NULL;
   }
 }
 
 static const char *field_names[MPMC_FIELD_COUNT] = {
-    "position", "velocity", "mass", "volume0", "J", "Jbar", "stress", "be", "eps_p", "force", "x0"};
+    "position", "velocity", "mass", "volume0", "J", "Jbar", "stress", "be", "eps_p", "force", "x0",
+    "region"};
 
 /**
  * @brief Borrow a particle field in place (no copy).  Layout [n][ncomp].

@@ -11,7 +11,7 @@ double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
   for (int m = 0; m < sim->nmat; ++m) {
     const double c = sim->mats[m].ops->wave_speed(&sim->mats[m]);
     if (c > cmax) cmax = c;
-    if (sim->mats[m].kind == MPMC_MAT_NEWTONIAN && sim->mats[m].mu > 0) {
+    if (sim->mats[m].mu > 0) {
       const double t = sim->grid.h * sim->grid.h * sim->mats[m].rho / (2.0 * sim->mats[m].mu);
       if (t < visc) visc = t;
     }

@@ -56,8 +56,8 @@ mpmc_j2_batch_fn mpmc_kernels_j2_batch(const struct mpmc_sim_s *sim) {
 }
 
 mpmc_stress_batch_fn mpmc_kernels_stress_batch(const struct mpmc_sim_s *sim, int model) {
-  return model == MPMC_MAT_NEWTONIAN ? KERNELS(sim)->newtonian_batch
-         : model == MPMC_MAT_HENCKY  ? KERNELS(sim)->hencky_batch
+  return model == MPMC_BATCH_NEWTONIAN ? KERNELS(sim)->newtonian_batch
+         : model == MPMC_BATCH_HENCKY  ? KERNELS(sim)->hencky_batch
                                      : KERNELS(sim)->nh_batch;
 }
 

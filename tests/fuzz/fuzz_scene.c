@@ -61,21 +61,17 @@ static void check_scene(const wf_scene *sc) {
   require(sc->threads >= 0, "threads >= 0", sc);
   require(sc->checkpoint_interval > 0 && sc->progress_interval > 0, "intervals > 0", sc);
   require(sc->nmat >= 1 && sc->mats, "at least one material", sc);
+  /* every material the reader accepts, the library accepts too (the same model table) */
+  mpmc_context ctx = NULL;
+  mpmc_sim sim = NULL;
+  require(!mpmc_context_create(&ctx) && !mpmc_sim_create(ctx, 2, &sim), "a simulation", sc);
   for (int i = 0; i < sc->nmat; ++i) {
     const wf_material *m = &sc->mats[i];
-    require(isfinite(m->rho) && m->rho > 0, "rho > 0", sc);
-    if (m->model == WF_MODEL_NEWTONIAN) {
-      require(isfinite(m->K) && m->K > 0 && isfinite(m->mu) && m->mu >= 0, "K > 0, mu >= 0", sc);
-      continue;
-    }
-    require(isfinite(m->E) && m->E > 0, "E > 0", sc);
-    require(m->nu >= 0 && m->nu < 0.5, "0 <= nu < 0.5", sc);
-    if (m->model == WF_MODEL_HENCKY_J2) {
-      require(isfinite(m->kappa_p) && m->kappa_p > 0, "kappa_p > 0", sc);
-      require(m->kappa_r > 0 && m->kappa_r <= m->kappa_p, "0 < kappa_r <= kappa_p", sc);
-      require(isfinite(m->eta) && m->eta >= 0, "eta >= 0", sc);
-    }
+    require(mpmc_sim_add_material(sim, wf_model_name(m->model), m->par, m->npar, NULL) == 0,
+            "the library accepts the material", sc);
   }
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
   require(sc->nbody >= 1 && sc->bodies, "at least one body", sc);
   for (int i = 0; i < sc->nbody; ++i) {
     const wf_body *b = &sc->bodies[i];
