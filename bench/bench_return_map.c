@@ -5,7 +5,12 @@
  * The same for elastic trial states, by the fast (series) and the eigen path.
  *   bench_return_map              timing table (markdown)
  *   bench_return_map --elastic    the elastic rows only (for callgrind)
- *   bench_return_map --stability  the stiff/extreme table of docs/stability.md */
+ *   bench_return_map --stability  the stiff/extreme table of docs/stability.md
+ *   bench_return_map --mc         Mohr-Coulomb / Drucker-Prager (return_mc.c) against J2
+ * The Mohr-Coulomb rows: a frictional soil (E = 25 MPa, nu = 0.3, c 20 -> 2 kPa, phi 30 -> 20
+ * deg, psi 10 -> 0 deg, eta = 5) on its yield surface at eps_p in [0, 2], mean stress
+ * -200..-10 kPa, random Lode angle and rotation, then the same 1e-3 increments as J2's.  The
+ * issue's target: the Mohr-Coulomb update at most 2x J2's per point. */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -19,6 +24,7 @@
 #include "j2_cases.h" /* tests/: the stiff/extreme table, shared with t403 */
 #include "linalg.h"
 #include "return_map.h"
+#include "return_mc.h"
 
 static double now(void) {
   struct timespec ts;
@@ -148,6 +154,136 @@ static int timing_elastic(void) {
   return 0;
 }
 
+
+/* ---- Mohr-Coulomb / Drucker-Prager ------------------------------------------------- */
+static mpmc_mc_param mc_soil(int surface, int soft) {
+  const double E = 25e6, nu = 0.3, d = M_PI / 180;
+  mpmc_mc_param m = {E / (3 * (1 - 2 * nu)), E / (2 * (1 + nu)), 20e3, 2e3, 30 * d, 20 * d,
+                     10 * d, 0.0, 5.0, INFINITY, surface};
+  if (!soft) m.c_r = m.c_p, m.phi_r = m.phi_p, m.psi_r = m.psi_p, m.eta = 0;
+  return m;
+}
+
+static double mc_be0[NS][6], mc_ep0[NS];
+
+/* states on the yield surface of m at eps_p (MC's f along p + q d is linear in q; DP: the
+ * same with sqrt(J2) = q |d| / sqrt 2), in a random frame */
+static void mc_states(const mpmc_mc_param *m) {
+  for (int i = 0; i < NS; ++i) {
+    mc_ep0[i] = 2.0 * urand();
+    double c, phi, psi;
+    mpmc_mc_soften(m, mc_ep0[i], &c, &phi, &psi);
+    const double p = -(10e3 + 190e3 * urand());
+    double dv[3] = {2 * urand() - 1, 2 * urand() - 1, 0};
+    dv[2] = -dv[0] - dv[1];
+    const double n = sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]);
+    for (int a = 0; a < 3; ++a) dv[a] /= n;
+    double hi = fmax(dv[0], fmax(dv[1], dv[2])), lo = fmin(dv[0], fmin(dv[1], dv[2]));
+    double q;
+    if (m->surface == MPMC_MC_MOHR_COULOMB)
+      q = (2 * c * cos(phi) - 2 * p * sin(phi)) / ((hi - lo) + (hi + lo) * sin(phi));
+    else {
+      const double sf = sin(phi), g = m->surface == MPMC_DP_COMPRESSION ? 3 - sf : 3 + sf;
+      const double eta = 6 * sf / (sqrt(3.0) * g), xi = 6 * cos(phi) / (sqrt(3.0) * g);
+      q = (xi * c - eta * p) * sqrt(2.0); /* the plane-strain matching is not timed */
+    }
+    double lam[3], R[3][3];
+    for (int a = 0; a < 3; ++a) {
+      const double s = p + 0.999 * q * dv[a]; /* just inside */
+      lam[a] = exp(2 * ((s - p) / (2 * m->G) + p / (3 * m->K)));
+    }
+    const double th = 2 * M_PI * urand(), ph = 2 * M_PI * urand();
+    const double Rz[3][3] = {{cos(th), -sin(th), 0}, {sin(th), cos(th), 0}, {0, 0, 1}};
+    const double Rx[3][3] = {{1, 0, 0}, {0, cos(ph), -sin(ph)}, {0, sin(ph), cos(ph)}};
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) {
+        R[r][k] = 0;
+        for (int l = 0; l < 3; ++l) R[r][k] += Rz[r][l] * Rx[l][k];
+      }
+    mpmc_sym3_compose(lam, R, mc_be0[i]);
+  }
+}
+
+/* best-of-reps ns per point of J2 (fast path or eigen path) on its landslide states */
+static double j2_ns(mpmc_rm_ws *ws, int eig) {
+  const mpmc_j2_param m = landslide();
+  make_states(&m);
+  double best = INFINITY, sink = 0;
+  for (int r = 0; r < 10; ++r) {
+    const double t0 = now();
+    for (int i = 0; i < NS; ++i) {
+      double be[6], ep = ep0[i], tau[6], J;
+      memcpy(be, be0[i], sizeof be);
+      mpmc_j2_info info = {0};
+      const int err = eig ? mpmc_j2_return_map_eig(ws, MPMC_SOLVER_AUTO, &m, Fs[i], be, &ep, tau, &J, &info)
+                          : mpmc_j2_return_map(ws, MPMC_SOLVER_AUTO, &m, Fs[i], be, &ep, tau, &J, &info);
+      if (err) return NAN;
+      sink += tau[0];
+    }
+    best = fmin(best, (now() - t0) / NS * 1e9);
+  }
+  if (sink == 42.0) printf(" ");
+  return best;
+}
+
+static int timing_mc(void) {
+  mpmc_rm_ws *ws;
+  if (mpmc_rm_ws_create(&ws)) return 1;
+  const double j2f = j2_ns(ws, 0), j2e = j2_ns(ws, 1);
+  printf("| model | solver | ns / point | plastic | fallbacks | mean iterations (newton + kinsol) | regions plane/edges/apex | / J2 fast | / J2 eigen |\n");
+  printf("|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  printf("| J2 (landslide) | auto | %.0f | | | | | 1.00 | %.2f |\n", j2f, j2f / j2e);
+  printf("| J2 (landslide), eigen path | auto | %.0f | | | | | %.2f | 1.00 |\n", j2e, j2e / j2f);
+  const char *names[3] = {"auto", "newton", "kinsol"};
+  const struct {
+    const char *label;
+    int surface, soft;
+  } models[] = {{"Mohr-Coulomb, softening", MPMC_MC_MOHR_COULOMB, 1},
+                {"Mohr-Coulomb, perfect", MPMC_MC_MOHR_COULOMB, 0},
+                {"Drucker-Prager (compression), softening", MPMC_DP_COMPRESSION, 1}};
+  for (int k = 0; k < 3; ++k) {
+    const mpmc_mc_param m = mc_soil(models[k].surface, models[k].soft);
+    rng = 88172645463325252ull;
+    const mpmc_j2_param lm = landslide();
+    make_states(&lm); /* the same increments Fs as J2's */
+    mc_states(&m);
+    for (int s = 0; s < 3; ++s) {
+      if (!models[k].soft && s) continue; /* one closed form for every solver */
+      const int reps = s == MPMC_SOLVER_KINSOL ? 3 : 10;
+      long plastic = 0, fb = 0, iters = 0, reg[8] = {0};
+      double best = INFINITY, sink = 0;
+      for (int r = 0; r < reps; ++r) {
+        const double t0 = now();
+        for (int i = 0; i < NS; ++i) {
+          double be[6], ep = mc_ep0[i], tau[6], J;
+          memcpy(be, mc_be0[i], sizeof be);
+          mpmc_mc_info info;
+          const int err = mpmc_mc_return_map(ws, s, &m, Fs[i], be, &ep, tau, &J, &info);
+          if (err) {
+            fprintf(stderr, "%s %s point %d: error %d\n", models[k].label, names[s], i, err);
+            return 2;
+          }
+          sink += tau[0];
+          if (r == 0) {
+            plastic += info.plastic;
+            fb += info.fallback;
+            iters += info.newton_iters + info.kinsol_iters;
+            reg[info.region]++;
+          }
+        }
+        best = fmin(best, (now() - t0) / NS * 1e9);
+      }
+      if (sink == 42.0) printf(" ");
+      printf("| %s | %s | %.0f | %ld / %d | %ld | %.2f | %ld/%ld/%ld | %.2f | %.2f |\n", models[k].label,
+             models[k].soft ? names[s] : "closed form", best, plastic, NS, fb,
+             plastic ? (double)iters / plastic : 0.0, reg[1], reg[2] + reg[3], reg[4], best / j2f,
+             best / j2e);
+    }
+  }
+  mpmc_rm_ws_destroy(&ws);
+  return 0;
+}
+
 static int stability(void) {
   mpmc_rm_ws *ws;
   if (mpmc_rm_ws_create(&ws)) return 1;
@@ -192,7 +328,10 @@ static int stability(void) {
 int main(int argc, char **argv) {
   if (argc > 1 && !strcmp(argv[1], "--stability")) return stability();
   if (argc > 1 && !strcmp(argv[1], "--elastic")) return timing_elastic();
-  const int err = timing();
+  if (argc > 1 && !strcmp(argv[1], "--mc")) return timing_mc();
+  int err = timing();
   printf("\n");
-  return err ? err : timing_elastic();
+  if (!err) err = timing_elastic();
+  printf("\n");
+  return err ? err : timing_mc();
 }
