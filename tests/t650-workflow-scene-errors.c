@@ -24,7 +24,7 @@ static const char *scene_fmt =
     "  hi: [2, 2]\n"                                /* 5 */
     "  %s\n"                                        /* 6: the cell_size line */
     "materials:\n"                                  /* 7 */
-    "  m: {model: hencky, E: 1.0e6, nu: 0.3, rho: 1000}\n" /* 8 */
+    "  m: %s\n"                                     /* 8: the material */
     "geometry:\n"                                   /* 9 */
     "  - %s\n"                                      /* 10: the body */
     "stages:\n"                                     /* 11 */
@@ -33,12 +33,14 @@ static const char *scene_fmt =
     "    end: {time: 0.002}\n";                     /* 14 */
 
 static const char *good_body = "{type: box, lo: [0, 0], hi: [1, 1]}";
+/* line 8's material (test_material_rules changes it) */
+static const char *material = "{model: hencky, E: 1.0e6, nu: 0.3, rho: 1000}";
 
 static void write_scene(const char *path, const char *cell_line, const char *body) {
   mkdir(DIR, 0777);
   FILE *f = fopen(path, "w");
   assert_non_null(f);
-  fprintf(f, scene_fmt, cell_line, body);
+  fprintf(f, scene_fmt, cell_line, material, body);
   fclose(f);
 }
 
@@ -84,6 +86,37 @@ static void check_bad(const char *name, const char *cell_line, const char *body,
   test_expect_in(name, msg, key);
   if (test_exists(sum)) fail_msg("%s: the program wrote %s for a bad scene", name, sum);
   if (!test_exists(marker)) fail_msg("%s: %s was removed", name, marker);
+}
+
+/* The model table's rules, as the scene reader applies them: each message names line 8, the
+ * key and the rule (the frictional models' ranges and "must not exceed" relations). */
+static void test_material_rules(void **state) {
+  (void)state;
+  static const struct {
+    const char *name, *mat, *key, *what;
+  } cases[] = {
+      {"mc_psi", "{model: mohr_coulomb, E: 1.0e6, nu: 0.3, rho: 1000, c: 1.0e3, phi: 20, psi: 25}",
+       "key 'materials.m.psi'", "must not exceed phi = 20 (got 25)"},
+      {"mc_phi", "{model: mohr_coulomb, E: 1.0e6, nu: 0.3, rho: 1000, c: 1.0e3, phi: 95}",
+       "key 'materials.m.phi'", "must be in [0, 90) (got 95)"},
+      {"mc_c", "{model: mohr_coulomb, E: 1.0e6, nu: 0.3, rho: 1000, c: -1, phi: 30}",
+       "key 'materials.m.c'", "must be >= 0 (got -1)"},
+      {"mc_cr", "{model: mohr_coulomb, E: 1.0e6, nu: 0.3, rho: 1000, c: 1.0e3, phi: 30, c_r: 2.0e3}",
+       "key 'materials.m.c_r'", "must not exceed c = 1000 (got 2000)"},
+      {"mc_missing", "{model: mohr_coulomb, E: 1.0e6, nu: 0.3, rho: 1000, c: 1.0e3}",
+       "key 'materials.m.phi'", "required key is missing: friction angle [deg]"},
+      {"dp_match", "{model: drucker_prager, E: 1.0e6, nu: 0.3, rho: 1000, c: 1.0e3, phi: 30, match: cone}",
+       "key 'materials.m.match'", "must be one of compression, extension, plane_strain"},
+      {"j2_both", "{model: hencky_j2, E: 1.0e6, nu: 0.3, rho: 1000, kappa_p: 1.0e3, su: 600}",
+       "key 'materials.m.su'", "give kappa_p or su, not both"},
+      {"mc_key", "{model: mohr_coulomb, E: 1.0e6, nu: 0.3, rho: 1000, c: 1.0e3, phi: 30, kappa_p: 1}",
+       "key 'materials.m.kappa_p'", "unknown key"},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+    material = cases[k].mat;
+    check_bad(cases[k].name, "cell_size: 0.5", good_body, "8:", cases[k].key, cases[k].what);
+  }
+  material = "{model: hencky, E: 1.0e6, nu: 0.3, rho: 1000}";
 }
 
 static void test_syntax_error(void **state) {
@@ -189,6 +222,7 @@ int main(void) {
       cmocka_unit_test(test_out_of_range), cmocka_unit_test(test_unknown_key),
       cmocka_unit_test(test_missing_mesh), cmocka_unit_test(test_bad_override),
       cmocka_unit_test(test_existing_output), cmocka_unit_test(test_usage),
+      cmocka_unit_test(test_material_rules),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

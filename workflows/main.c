@@ -1,4 +1,5 @@
 /* `mpmc`: the command-line front end of the staged workflow (docs/workflows.md). */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,11 +10,14 @@ static const char usage[] =
     "usage: mpmc run SCENE.yaml [--out DIR] [--set key.path=value ...] [--threads N] [--force] [--quiet]\n"
     "       mpmc check SCENE.yaml [--set key.path=value ...]\n"
     "       mpmc resume DIR [--set key.path=value ...] [--threads N] [--quiet]\n"
+    "       mpmc models\n"
     "       mpmc --help | --version\n"
     "\n"
     "  run     run every stage of the scene; outputs go to DIR (default out/<scene>):\n"
     "          summary.json, series.csv, snapshots.h5/.xdmf, checkpoint.h5, PNG plots\n"
     "  check   validate the scene (and the --set overrides) and print what would run\n"
+    "  models  print the material models a scene may name, with their parameters (units,\n"
+    "          ranges, defaults) as Markdown: the table of docs/materials.md\n"
     "  resume  continue a run from the last checkpoint in DIR (--set: after the run's own\n"
     "          overrides); a finished run goes on once its scene has another stage or a\n"
     "          later end for its last one, e.g. --set stages.runout.end.time=8\n"
@@ -39,6 +43,56 @@ static void print_error(mpmc_context ctx, int code) {
   fprintf(stderr, "mpmc: error: %s\n", body[0] ? body : mpmc_error_string(code));
 }
 
+/* One model's parameters as a Markdown table, from the library's model table. */
+static void print_model(int k) {
+  mpmc_model_info mi;
+  if (mpmc_model_get_info(k, &mi) || mi.needs_function) return;
+  printf("### `%s`\n\n%s.\n\n| key | unit | meaning | valid | default |\n|---|---|---|---|---|\n",
+         mi.name, mi.doc);
+  for (int j = 0; j < mi.nparam; ++j) {
+    mpmc_param_info pi;
+    if (mpmc_model_get_param(k, j, &pi)) continue;
+    char valid[160], def[160] = "required";
+    if (pi.nwords > 0) {
+      size_t l = 0;
+      valid[0] = 0;
+      for (int w = 0; w < pi.nwords && l < sizeof valid; ++w)
+        l += (size_t)snprintf(valid + l, sizeof valid - l, "%s`%s`", w ? ", " : "", pi.words[w]);
+    } else if (pi.hi == INFINITY) {
+      snprintf(valid, sizeof valid, "%s %g", pi.lo_open ? ">" : "≥", pi.lo);
+    } else {
+      snprintf(valid, sizeof valid, "%c%g, %g%c", pi.lo_open ? '(' : '[', pi.lo, pi.hi,
+               pi.hi_open ? ')' : ']');
+    }
+    if (pi.at_most >= 0) {
+      mpmc_param_info top;
+      if (!mpmc_model_get_param(k, pi.at_most, &top))
+        snprintf(valid + strlen(valid), sizeof valid - strlen(valid), ", ≤ `%s`", top.name);
+    }
+    if (pi.alias_of >= 0) {
+      mpmc_param_info of;
+      mpmc_model_get_param(k, pi.alias_of, &of);
+      snprintf(def, sizeof def, "instead of `%s` (= %.9g × this)", of.name, pi.scale);
+    } else if (pi.optional && pi.default_of >= 0) {
+      mpmc_param_info of;
+      mpmc_model_get_param(k, pi.default_of, &of);
+      snprintf(def, sizeof def, "`%s`", of.name);
+    } else if (pi.optional && pi.nwords > 0) {
+      snprintf(def, sizeof def, "`%s`", pi.words[(int)pi.def]);
+    } else if (pi.optional) {
+      if (pi.def == INFINITY)
+        snprintf(def, sizeof def, "none");
+      else
+        snprintf(def, sizeof def, "%g", pi.def);
+    }
+    const char *srm = pi.strength == 1 ? " (÷ F in strength reduction)"
+                      : pi.strength == 2 ? " (tan ÷ F in strength reduction)"
+                                         : "";
+    printf("| `%s` | %s | %s%s | %s | %s |\n", pi.name, pi.unit, pi.doc, srm, valid, def);
+  }
+  printf("\n");
+}
+
 int main(int argc, char **argv) {
   if (argc < 2 || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
     fputs(usage, argc < 2 ? stderr : stdout);
@@ -51,6 +105,12 @@ int main(int argc, char **argv) {
     return 0;
   }
   const char *cmd = argv[1];
+  if (!strcmp(cmd, "models")) {
+    int n = 0;
+    mpmc_model_count(&n);
+    for (int k = 0; k < n; ++k) print_model(k);
+    return 0;
+  }
   if (strcmp(cmd, "run") && strcmp(cmd, "check") && strcmp(cmd, "resume")) {
     fprintf(stderr, "mpmc: unknown command '%s'\n%s", cmd, usage);
     return 2;

@@ -27,7 +27,7 @@ static int nh_setup(mpmc_context ctx, mpmc_material *m) {
 
 const mpmc_model mpmc_model_neo_hookean = {
     .name = "neo_hookean",
-    .doc = "compressible Neo-Hookean elasticity",
+    .doc = "Compressible Neo-Hookean elasticity",
     .nparam = 3,
     .nstore = 3,
     .param = params,

@@ -31,7 +31,7 @@ static int newtonian_setup(mpmc_context ctx, mpmc_material *m) {
 
 const mpmc_model mpmc_model_newtonian = {
     .name = "newtonian",
-    .doc = "nearly incompressible Newtonian fluid",
+    .doc = "Nearly incompressible Newtonian fluid",
     .nparam = 3,
     .nstore = 3,
     .param = params,
