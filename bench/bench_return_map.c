@@ -10,7 +10,15 @@
  * The Mohr-Coulomb rows: a frictional soil (E = 25 MPa, nu = 0.3, c 20 -> 2 kPa, phi 30 -> 20
  * deg, psi 10 -> 0 deg, eta = 5) on its yield surface at eps_p in [0, 2], mean stress
  * -200..-10 kPa, random Lode angle and rotation, then the same 1e-3 increments as J2's.  The
- * issue's target: the Mohr-Coulomb update at most 2x J2's per point. */
+ * issue's target: the Mohr-Coulomb update at most 2x J2's per point.
+ * The second --mc table is like for like: the same b_e^n, eps_p and increment for J2 and the
+ * frictional models, with J2's strength matched point by point to Mohr-Coulomb's at the
+ * state's mean stress and Lode angle (kappa = sqrt(3/2) |dev tau| at yield, peak and
+ * residual, the same eta), on a slope-like mix (80 % never yielded at 20-90 % of the
+ * strength, 20 % on the surface with eps_p in [0, 2]; increments 1e-4) and on an all-plastic
+ * set (trial states plastic for both models); the rows give ns per point of J2's point update
+ * (series path), the frictional update (mpmc_mc_update) and its eigen path alone
+ * (mpmc_mc_return_map_eig), and the ratio to J2. */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -284,6 +292,146 @@ static int timing_mc(void) {
   return 0;
 }
 
+/* ---- like for like: the same trial states for J2 and the frictional models ------------ */
+static double ll_be[NS][6], ll_ep[NS], ll_F[NS][3][3];
+static mpmc_j2_param ll_j2[NS];
+
+/* the multiplier of the unit deviatoric direction dv (|dv| = 1) that puts p + q dv on
+ * Mohr-Coulomb's surface with c, phi */
+static double mc_qm(double c, double phi, double p, const double dv[3]) {
+  const double hi = fmax(dv[0], fmax(dv[1], dv[2])), lo = fmin(dv[0], fmin(dv[1], dv[2]));
+  return (2 * c * cos(phi) - 2 * p * sin(phi)) / ((hi - lo) + (hi + lo) * sin(phi));
+}
+
+/* one state: mean stress p, a random Lode angle at ratio r of the strength at eps_p, a
+ * random frame, an increment of size h; J2's kappa matched at (p, Lode angle) */
+static void ll_state(const mpmc_mc_param *m, int i, double r, double ep, double h) {
+  double c, phi, psi;
+  mpmc_mc_soften(m, ep, &c, &phi, &psi);
+  const double p = -(10e3 + 190e3 * urand());
+  double dv[3] = {2 * urand() - 1, 2 * urand() - 1, 0};
+  dv[2] = -dv[0] - dv[1];
+  const double n = sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]);
+  for (int a = 0; a < 3; ++a) dv[a] /= n;
+  const double q = r * mc_qm(c, phi, p, dv);
+  double lam[3], R[3][3];
+  for (int a = 0; a < 3; ++a) {
+    const double s = p + q * dv[a];
+    lam[a] = exp(2 * ((s - p) / (2 * m->G) + p / (3 * m->K)));
+  }
+  const double th = 2 * M_PI * urand(), ph = 2 * M_PI * urand();
+  const double Rz[3][3] = {{cos(th), -sin(th), 0}, {sin(th), cos(th), 0}, {0, 0, 1}};
+  const double Rx[3][3] = {{1, 0, 0}, {0, cos(ph), -sin(ph)}, {0, sin(ph), cos(ph)}};
+  for (int a = 0; a < 3; ++a)
+    for (int k = 0; k < 3; ++k) {
+      R[a][k] = 0;
+      for (int l = 0; l < 3; ++l) R[a][k] += Rz[a][l] * Rx[l][k];
+    }
+  mpmc_sym3_compose(lam, R, ll_be[i]);
+  ll_ep[i] = ep;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) ll_F[i][a][b] = (a == b) + h * (2 * urand() - 1);
+  const double s3 = sqrt(1.5);
+  ll_j2[i] = (mpmc_j2_param){m->K, m->G, s3 * mc_qm(m->c_p, m->phi_p, p, dv),
+                             s3 * mc_qm(m->c_r, m->phi_r, p, dv), m->eta};
+}
+
+/* the slope-like mix (set 0) or the all-plastic set (1) of Mohr-Coulomb material m */
+static int ll_states(const mpmc_mc_param *m, int set, mpmc_rm_ws *ws) {
+  for (int i = 0; i < NS; ++i) {
+    if (set == 0) {
+      if (urand() < 0.8)
+        ll_state(m, i, 0.2 + 0.7 * urand(), 0.0, 1e-4);
+      else
+        ll_state(m, i, 0.999, 2.0 * urand(), 1e-4);
+      continue;
+    }
+    for (int tries = 0;; ++tries) { /* plastic for both */
+      if (tries > 1000) return 1;
+      ll_state(m, i, 0.999, 2.0 * urand(), 1e-3);
+      double be[6], ep = ll_ep[i], tau[6], J;
+      mpmc_j2_info ji = {0};
+      mpmc_mc_info mi;
+      memcpy(be, ll_be[i], sizeof be);
+      if (mpmc_j2_return_map(ws, MPMC_SOLVER_AUTO, &ll_j2[i], ll_F[i], be, &ep, tau, &J, &ji)) return 2;
+      ep = ll_ep[i];
+      memcpy(be, ll_be[i], sizeof be);
+      if (mpmc_mc_return_map(ws, MPMC_SOLVER_AUTO, m, ll_F[i], be, &ep, tau, &J, &mi)) return 3;
+      if (ji.plastic && mi.plastic) break;
+    }
+  }
+  return 0;
+}
+
+/* best of 10 runs, ns per point: path 0 J2, 1 the frictional update, 2 its eigen path */
+static double ll_time(mpmc_rm_ws *ws, const mpmc_mc_param *m, int path, long *plastic) {
+  mpmc_mc_pre pre;
+  mpmc_mc_prepare(m, &pre);
+  double best = INFINITY, sink = 0;
+  *plastic = 0;
+  for (int r = 0; r < 10; ++r) {
+    long np = 0;
+    const double t0 = now();
+    for (int i = 0; i < NS; ++i) {
+      double be[6], ep = ll_ep[i], tau[6], J;
+      memcpy(be, ll_be[i], sizeof be);
+      int err, pl;
+      if (path == 0) {
+        mpmc_j2_info info = {0};
+        err = mpmc_j2_return_map(ws, MPMC_SOLVER_AUTO, &ll_j2[i], ll_F[i], be, &ep, tau, &J, &info);
+        pl = info.plastic;
+      } else {
+        mpmc_mc_info info;
+        err = path == 1 ? mpmc_mc_update(ws, MPMC_SOLVER_AUTO, &pre, ll_F[i], be, &ep, tau, &J, &info)
+                        : mpmc_mc_return_map_eig(ws, MPMC_SOLVER_AUTO, m, ll_F[i], be, &ep, tau, &J, &info);
+        pl = info.plastic;
+      }
+      if (err) {
+        fprintf(stderr, "like for like, path %d, point %d: error %d\n", path, i, err);
+        return NAN;
+      }
+      np += pl;
+      sink += tau[0];
+    }
+    best = fmin(best, (now() - t0) / NS * 1e9);
+    *plastic = np;
+  }
+  if (sink == 42.0) printf(" ");
+  return best;
+}
+
+static int timing_like(void) {
+  mpmc_rm_ws *ws;
+  if (mpmc_rm_ws_create(&ws)) return 1;
+  printf("| states | model | ns / point J2 | ns / point model | ratio | eigen path alone | plastic J2 / model |\n");
+  printf("|---|---|---:|---:|---:|---:|---:|\n");
+  const char *sets[2] = {"slope mix", "all plastic"};
+  const struct {
+    const char *label;
+    int surface, soft;
+  } models[] = {{"Mohr-Coulomb, softening", MPMC_MC_MOHR_COULOMB, 1},
+                {"Mohr-Coulomb, perfect", MPMC_MC_MOHR_COULOMB, 0},
+                {"Drucker-Prager (compression), softening", MPMC_DP_COMPRESSION, 1}};
+  for (int set = 0; set < 2; ++set)
+    for (int k = 0; k < 3; ++k) {
+      const mpmc_mc_param m = mc_soil(models[k].surface, models[k].soft);
+      rng = 88172645463325252ull;
+      /* the states come from Mohr-Coulomb's strength: the same b_e, eps_p, F for every row */
+      const mpmc_mc_param mmc = mc_soil(MPMC_MC_MOHR_COULOMB, models[k].soft);
+      if (ll_states(&mmc, set, ws)) {
+        fprintf(stderr, "like for like: no plastic states\n");
+        return 2;
+      }
+      long pj, pm, pe;
+      const double tj = ll_time(ws, &m, 0, &pj), tm = ll_time(ws, &m, 1, &pm), te = ll_time(ws, &m, 2, &pe);
+      if (!(isfinite(tj) && isfinite(tm) && isfinite(te))) return 3;
+      printf("| %s | %s | %.0f | %.0f | %.2f | %.0f | %ld / %ld of %d |\n", sets[set], models[k].label, tj,
+             tm, tm / tj, te, pj, pm, NS);
+    }
+  mpmc_rm_ws_destroy(&ws);
+  return 0;
+}
+
 static int stability(void) {
   mpmc_rm_ws *ws;
   if (mpmc_rm_ws_create(&ws)) return 1;
@@ -328,10 +476,16 @@ static int stability(void) {
 int main(int argc, char **argv) {
   if (argc > 1 && !strcmp(argv[1], "--stability")) return stability();
   if (argc > 1 && !strcmp(argv[1], "--elastic")) return timing_elastic();
-  if (argc > 1 && !strcmp(argv[1], "--mc")) return timing_mc();
+  if (argc > 1 && !strcmp(argv[1], "--mc")) {
+    const int err = timing_mc();
+    printf("\n");
+    return err ? err : timing_like();
+  }
   int err = timing();
   printf("\n");
   if (!err) err = timing_elastic();
   printf("\n");
-  return err ? err : timing_mc();
+  if (!err) err = timing_mc();
+  printf("\n");
+  return err ? err : timing_like();
 }

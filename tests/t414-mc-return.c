@@ -3,7 +3,8 @@
  * here by hand (perfect plasticity), the yield conditions after random returns, the three
  * Drucker-Prager matchings against Mohr-Coulomb's strengths, the apexes, newton vs kinsol vs
  * auto on random softening states and on steep softening, objectivity, strength reduction,
- * and two element tests at the tensor level: drained triaxial compression (peak and
+ * the eigen-free elastic check against the eigen path, and three element tests at the
+ * tensor level: drained triaxial compression and plane-strain biaxial compression (peak and
  * residual strength) and simple shear (volume change from the dilation angle). */
 #include <float.h>
 #include <setjmp.h>
@@ -498,6 +499,50 @@ static void test_objectivity(void **state) {
   }
 }
 
+/* ---- the elastic check without eigenvectors (mpmc_mc_update) against the eigen path ---- */
+static void test_fast_vs_eig(void **state) {
+  (void)state;
+  int nel = 0, npl = 0;
+  for (int k = 0; k < 6000; ++k) {
+    mpmc_mc_param m;
+    double s[3], ep0;
+    random_case(&m, s, &ep0, k % 3 == 0, 50.0);
+    if (k % 2) /* towards the hydrostatic axis below the apex: mostly elastic */
+      for (int a = 0; a < 3; ++a) s[a] = -m.c_p + 0.1 * (s[a] + m.c_p);
+    double e[3], lam[3], Q[3][3], be[6], be2[6], tau[6], tau2[6], J, J2, F[3][3];
+    strain_of(&m, s, e);
+    for (int a = 0; a < 3; ++a) lam[a] = exp(2 * e[a]);
+    rand_rotation(Q);
+    mpmc_sym3_compose(lam, Q, be);
+    memcpy(be2, be, sizeof be);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) F[i][j] = (i == j) + 1e-4 * (2 * urand() - 1);
+    double ep = ep0, ep2 = ep0;
+    mpmc_mc_info info, info2;
+    const int err = mpmc_mc_return_map(ws, MPMC_SOLVER_AUTO, &m, F, be, &ep, tau, &J, &info);
+    const int err2 = mpmc_mc_return_map_eig(ws, MPMC_SOLVER_AUTO, &m, F, be2, &ep2, tau2, &J2, &info2);
+    if (err != err2) fail_msg("case %d: error %d, eigen path %d", k, err, err2);
+    if (err) continue;
+    if (info.plastic != info2.plastic || info.region != info2.region)
+      fail_msg("case %d: plastic %d region %d, eigen path plastic %d region %d", k, info.plastic,
+               info.region, info2.plastic, info2.region);
+    const double sc = absmax3(s) + m.c_p, rt = 64 * DBL_EPSILON * (m.K + m.G);
+    for (int c = 0; c < 6; ++c) {
+      if (!(fabs(tau[c] - tau2[c]) <= 1e-12 * sc + rt))
+        fail_msg("case %d (plastic %d): tau[%d] = %.17g, eigen path %.17g", k, info.plastic, c,
+                 tau[c], tau2[c]);
+      if (!(fabs(be[c] - be2[c]) <= 64 * DBL_EPSILON * (1 + fabs(be2[c]))))
+        fail_msg("case %d (plastic %d): b_e[%d] = %.17g, eigen path %.17g", k, info.plastic, c,
+                 be[c], be2[c]);
+    }
+    TCLOSE(ep, ep2, 1e-12 * (ep2 + sc / m.G) + rt / m.G);
+    TCLOSE(J, J2, 1e-14 * J2);
+    nel += !info.plastic;
+    npl += info.plastic;
+  }
+  if (nel < 1500 || npl < 1500) fail_msg("only %d elastic and %d plastic cases", nel, npl);
+}
+
 /* ---- strength reduction ------------------------------------------------------------- */
 static void test_reduce(void **state) {
   (void)state;
@@ -582,6 +627,75 @@ static void test_triaxial(void **state) {
     fail_msg("triaxial residual q = %.6g (eps_p %.3g), Mohr-Coulomb %.6g", q, st.ep, qres);
 }
 
+/* one plane-strain step (1 + da, 1 + x, 1) from st; lateral Kirchhoff stress tau_yy */
+static double bx_step(const mpmc_mc_param *m, const pstate *st, double da, double x, pstate *out,
+                      double tau[6], mpmc_mc_info *info) {
+  double F[3][3] = {{1 + da, 0, 0}, {0, 1 + x, 0}, {0, 0, 1}}, J;
+  *out = *st;
+  const int err = mpmc_mc_return_map(ws, MPMC_SOLVER_AUTO, m, F, out->be, &out->ep, tau, &J, info);
+  if (err) fail_msg("biaxial step: error %d", err);
+  return tau[1];
+}
+
+/* Plane-strain biaxial compression: stretch (1 + da, 1 + x, 1) per step, eps_zz = 0 held,
+ * confining Kirchhoff stress s_c < 0 held on y by the lateral stretch x, axial compression
+ * along x by 1e-4 steps.
+ * Peak (tension positive, s1 >= s2 >= s3): x is the most compressive, s3 = tau_xx, and the
+ * confinement the least, s1 = tau_yy = s_c; the out-of-plane tau_zz is the intermediate one
+ * (elastically it moves by lambda d(eps_xx + eps_yy), between the two; plastically the flow
+ * N = (1 + sin psi, 0, -(1 - sin psi)) of the main plane has no zz part, associated or not,
+ * so eps_zz = 0 needs no change of it), checked below.  Mohr-Coulomb's main plane then
+ * holds alone: (s1 - s3) + (s1 + s3) sin phi = 2 c cos phi with s1 = s_c, q = s1 - s3:
+ *   q + (2 s_c - q) sin phi = 2 c cos phi  =>  q = 2 (c cos phi - s_c sin phi) / (1 - sin phi),
+ * i.e. with the compression-positive confinement s3' = -s_c:
+ *   q = 2 c cos phi / (1 - sin phi) + 2 s3' sin phi / (1 - sin phi);
+ * the same with c_r, phi_r for the residual.  The intermediate stress plays no part, so the
+ * peak equals triaxial compression's at the same confinement. */
+static void test_biaxial(void **state) {
+  (void)state;
+  mpmc_mc_param m = base();
+  m.c_r = 2e3;
+  m.phi_r = 22 * DEG;
+  m.psi_p = 5 * DEG;
+  m.psi_r = 0;
+  m.eta = 60;
+  const double sc = -100e3;
+  pstate st = {{0}, 0};
+  for (int a = 0; a < 3; ++a) st.be[a] = exp(2 * sc / (3 * m.K));
+  const double sp = sin(m.phi_p), sr = sin(m.phi_r);
+  const double qpk = 2 * m.c_p * cos(m.phi_p) / (1 - sp) + 2 * -sc * sp / (1 - sp);
+  const double qres = 2 * m.c_r * cos(m.phi_r) / (1 - sr) + 2 * -sc * sr / (1 - sr);
+  double qmax = 0, q = 0, x = 0, tau[6];
+  int nplane = 0;
+  for (int step = 0; step < 1500; ++step) {
+    pstate nx;
+    mpmc_mc_info info;
+    /* secant on the lateral stretch for tau_yy = s_c; F_zz = 1 keeps eps_zz = 0 */
+    double x0 = x, g0 = bx_step(&m, &st, -1e-4, x0, &nx, tau, &info) - sc;
+    double x1 = x0 + 1e-5, g1 = bx_step(&m, &st, -1e-4, x1, &nx, tau, &info) - sc;
+    for (int it = 0; it < 40 && fabs(g1) > 1e-9 * fabs(sc); ++it) {
+      const double x2 = x1 - g1 * (x1 - x0) / (g1 - g0);
+      x0 = x1, g0 = g1, x1 = x2;
+      g1 = bx_step(&m, &st, -1e-4, x1, &nx, tau, &info) - sc;
+    }
+    if (!(fabs(g1) <= 1e-9 * fabs(sc))) fail_msg("step %d: lateral stress not held (%g)", step, g1);
+    /* tau_zz between tau_xx and tau_yy: the out-of-plane stress is the intermediate one */
+    if (!(tau[2] <= tau[1] + 1e-9 * fabs(sc) && tau[2] >= tau[0] - 1e-9 * fabs(sc)))
+      fail_msg("step %d: tau_zz = %.6g not between tau_xx = %.6g and tau_yy = %.6g", step, tau[2],
+               tau[0], tau[1]);
+    nplane += info.plastic && info.region == MPMC_MC_PLANE;
+    x = x1;
+    st = nx;
+    q = tau[1] - tau[0];
+    qmax = fmax(qmax, q);
+  }
+  if (nplane < 1000) fail_msg("biaxial: only %d plastic steps on the main plane", nplane);
+  if (!(fabs(qmax - qpk) <= 5e-3 * qpk))
+    fail_msg("biaxial peak q = %.6g, Mohr-Coulomb %.6g", qmax, qpk);
+  if (!(fabs(q - qres) <= 5e-3 * qres))
+    fail_msg("biaxial residual q = %.6g (eps_p %.3g), Mohr-Coulomb %.6g", q, st.ep, qres);
+}
+
 /* Simple shear (det F = 1) from a confining state: the plastic volumetric log strain
  * ln J_p = ln det F - tr(eps_e) = tr(eps_e0) - tr(eps_e) stays 0 with psi = 0, and with
  * psi > 0 grows at d(ln J_p) / d eps_p = 3 sin(psi) / sqrt(3 + sin^2 psi) on the main plane
@@ -634,7 +748,8 @@ int main(void) {
       cmocka_unit_test(test_dp),               cmocka_unit_test(test_solvers_agree),
       cmocka_unit_test(test_steep_softening),  cmocka_unit_test(test_objectivity),
       cmocka_unit_test(test_reduce),           cmocka_unit_test(test_triaxial),
-      cmocka_unit_test(test_simple_shear),
+      cmocka_unit_test(test_simple_shear),     cmocka_unit_test(test_fast_vs_eig),
+      cmocka_unit_test(test_biaxial),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

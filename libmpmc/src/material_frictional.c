@@ -1,6 +1,8 @@
 /* The frictional models' shared update: for every point of the material, b_e pushed forward
- * by dF (dF-bar with F-bar on), the return map of return_mc.c in principal stress space,
- * then the Cauchy stress tau / J (J-bar with F-bar on).  Points in parallel, each thread
+ * by dF (dF-bar with F-bar on), the return map of return_mc.c (mpmc_mc_update: an elastic
+ * check without eigen-decomposition, the principal-space return for the plastic points),
+ * then the Cauchy stress tau / J (J-bar with F-bar on).  The material's sines, cosines and
+ * cut-off are worked out once per call (mpmc_mc_prepare).  Points in parallel, each thread
  * with its own return-map workspace (KINSOL memory). */
 #include <limits.h>
 #include <math.h>
@@ -55,6 +57,8 @@ int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int
   mpmc_particles *p = &sim->p;
   const int d = sim->dim, solver = sim->solver;
   const mpmc_mc_param mp = frictional_param(mat, surface);
+  mpmc_mc_pre pre;
+  mpmc_mc_prepare(&mp, &pre);
   mpmc_rm_ws **ws;
   MPMC_CALL(mpmc_rm_sim_workspaces(sim, mpmc_max_threads(), &ws));
   const double *Jm = sim->fbar ? p->Jbar : p->J;
@@ -75,7 +79,7 @@ int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int
       double *beq = p->be + (size_t)q * 6;
       for (int k = 0; k < 6; ++k) be[k] = beq[k];
       mpmc_mc_info info = {0};
-      const int err = mpmc_mc_return_map(w, solver, &mp, F, be, &ep, tau, &Je, &info);
+      const int err = mpmc_mc_update(w, solver, &pre, F, be, &ep, tau, &Je, &info);
       if (err || !mpmc_stress_finite(tau) || !(Jm[q] > 0)) {
         if (q < first_bad) first_bad = q; /* its state is left as it was */
         continue;
@@ -98,7 +102,7 @@ int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int
   mpmc_embed(d, p->dF + (size_t)q * d * d, F);
   for (int k = 0; k < 6; ++k) be[k] = p->be[(size_t)q * 6 + k];
   mpmc_mc_info info = {0};
-  const int err = mpmc_mc_return_map(ws[0], solver, &mp, F, be, &ep, tau, &Je, &info);
+  const int err = mpmc_mc_update(ws[0], solver, &pre, F, be, &ep, tau, &Je, &info);
   const double *x = p->x + (size_t)q * d;
   char nb[MPMC_POINT_NAME_LEN];
   return MPMC_ERROR(sim->ctx, err ? err : MPMC_ERR_NUMERIC,

@@ -52,6 +52,9 @@ typedef struct {
   double ep0;     /* eps_p^n                                              */
   int frozen;     /* parameters fixed at x_r + (x_p - x_r) e_frozen         */
   double e_frozen;
+  mc_mat qf;      /* the material at e_frozen (sys_freeze): no sin, cos per evaluation */
+  mc_mat q0;      /* the material at eps_p^n, e0 = e_of(eps_p^n)                        */
+  double e0;
   double tolf;    /* tolerance on f [Pa]                                  */
   double yscale;  /* typical size of a multiplier (strain)                */
 } mc_sys;
@@ -125,11 +128,21 @@ static inline double e_of(const mpmc_mc_param *m, double ep) {
   return m->eta > 0.0 ? exp(-m->eta * ep) : 1.0;
 }
 
-static inline void sys_mat(const mc_sys *S, double D, mc_mat *q) {
-  if (S->frozen)
-    mat_eval(S->m, S->e_frozen, 1, q);
+/* the material of S at eps_p^n + D: the cached one when frozen, else evaluated into *buf */
+static inline const mc_mat *sys_mat(const mc_sys *S, double D, mc_mat *buf) {
+  if (S->frozen) return &S->qf;
+  mat_eval(S->m, e_of(S->m, S->ep0 + D), 0, buf);
+  return buf;
+}
+
+/* fix S's parameters at e (the values mat_eval gives, computed once) */
+static inline void sys_freeze(mc_sys *S, double e) {
+  S->frozen = 1;
+  S->e_frozen = e;
+  if (e == S->e0)
+    S->qf = S->q0;
   else
-    mat_eval(S->m, e_of(S->m, S->ep0 + D), 0, q);
+    mat_eval(S->m, e, 1, &S->qf);
 }
 
 /* De v in principal space */
@@ -182,11 +195,11 @@ static void eval_planes(const mc_sys *S, const double *y, double *R, double J[MC
                         double sig[3]) {
   const int n = S->n;
   const mpmc_mc_param *m = S->m;
-  mc_mat q;
-  sys_mat(S, y[n], &q);
+  mc_mat qb;
+  const mc_mat *q = sys_mat(S, y[n], &qb);
   double a[3][3], da[3][3], N[3][3], dN[3][3], k[3], dk[3], M[3] = {0, 0, 0}, dM[3] = {0, 0, 0};
   for (int j = 0; j < n; ++j) {
-    plane(S->act[j], &q, a[j], da[j], N[j], dN[j], &k[j], &dk[j]);
+    plane(S->act[j], q, a[j], da[j], N[j], dN[j], &k[j], &dk[j]);
     for (int i = 0; i < 3; ++i) {
       M[i] += y[j] * N[j][i];
       dM[i] += y[j] * dN[j][i];
@@ -222,8 +235,8 @@ static void eval_dp(const mc_sys *S, const double *y, double *R, double J[MC_NMA
                     double sig[3]) {
   const int n = S->n;
   const mpmc_mc_param *m = S->m;
-  mc_mat q;
-  sys_mat(S, y[n], &q);
+  mc_mat qb;
+  const mc_mat *q = sys_mat(S, y[n], &qb);
   int jd = -1; /* the cone's place in y; -1: cut-off planes only */
   double M[3] = {0, 0, 0}, x[3], DM[3];
   for (int j = 0; j < n; ++j) {
@@ -239,11 +252,11 @@ static void eval_dp(const mc_sys *S, const double *y, double *R, double J[MC_NMA
   const double sx[3] = {x[0] - px, x[1] - px, x[2] - px};
   const double rj = sqrt(0.5 * dot3(sx, sx));
   const double ratio = rj > 0.0 ? 1.0 - m->G * yd / rj : 0.0;
-  const double p = px - m->K * q.etab * yd;
+  const double p = px - m->K * q->etab * yd;
   double s[3];
   for (int i = 0; i < 3; ++i) s[i] = p + ratio * sx[i];
   for (int j = 0; j < n; ++j)
-    R[j] = S->act[j] == S_DP ? rj - m->G * yd + q.eta * p - q.xi * q.c : s[S->act[j] - S_T1] - q.st;
+    R[j] = S->act[j] == S_DP ? rj - m->G * yd + q->eta * p - q->xi * q->c : s[S->act[j] - S_T1] - q->st;
   /* plastic deviatoric strain: the cut-off's dev M and the cone's yd s_x / (2 sqrt J2) */
   const double trM = (M[0] + M[1] + M[2]) / 3.0;
   double u[3];
@@ -253,8 +266,8 @@ static void eval_dp(const mc_sys *S, const double *y, double *R, double J[MC_NMA
     for (int i = 0; i < 3; ++i) sig[i] = s[i];
   if (!J) return;
   if (n == 1 && jd == 0) { /* the cone alone: R_n = D - |yd| / sqrt3 */
-    J[0][0] = -m->G - m->K * q.eta * q.etab;
-    J[0][1] = q.deta * p - q.eta * m->K * q.detab * yd - q.dxi * q.c - q.xi * q.dc;
+    J[0][0] = -m->G - m->K * q->eta * q->etab;
+    J[0][1] = q->deta * p - q->eta * m->K * q->detab * yd - q->dxi * q->c - q->xi * q->dc;
     J[1][0] = (yd >= 0.0 ? -1.0 : 1.0) / sqrt(3.0);
     J[1][1] = 1.0;
     return;
@@ -379,8 +392,7 @@ static int newton(const mc_sys *S, int strict, double *y, mpmc_mc_info *info) {
  * then D = sqrt(2/3) |dev dEps^p|; with Drucker-Prager's cone and the cut-off, Newton. */
 static int solve_frozen(const mc_sys *S0, double e, double *y, mpmc_mc_info *info) {
   mc_sys S = *S0;
-  S.frozen = 1;
-  S.e_frozen = e;
+  sys_freeze(&S, e);
   const int n = S.n;
   for (int i = 0; i < MC_NMAX; ++i) y[i] = 0.0;
   if (S.dp && n > 1) return newton(&S, 0, y, info);
@@ -547,13 +559,12 @@ static int solve_kinsol(mpmc_rm_ws *ws, const mc_sys *S, double *y, mpmc_mc_info
 static int solve_region(mpmc_rm_ws *ws, int solver, const mc_sys *S, int perfect, double *y,
                         mpmc_mc_info *info, int *err) {
   *err = 0;
-  const double e0 = e_of(S->m, S->ep0);
+  const double e0 = S->e0;
   if (perfect) {
     if (solve_frozen(S, e0, y, info)) return 1;
     double R[MC_NMAX];
     mc_sys Sf = *S;
-    Sf.frozen = 1;
-    Sf.e_frozen = e0;
+    sys_freeze(&Sf, e0);
     sys_eval(&Sf, y, R, NULL, NULL);
     return rnorm(&Sf, R) <= 1.0 ? 0 : 1;
   }
@@ -634,6 +645,16 @@ static const mc_region dp_regions[] = {
     {3, {S_DP, S_T1, S_T2}, MPMC_MC_TENSION_CORNER},
 };
 
+/* the material is one mpmc_mc_return_principal accepts */
+static int param_ok(const mpmc_mc_param *m) {
+  return m->K > 0 && m->G > 0 && m->c_r >= 0 && m->c_p >= m->c_r && m->eta >= 0 &&
+         m->phi_p >= 0 && m->phi_r >= 0 && m->phi_p < 0.5 * acos(-1.0) &&
+         m->phi_r < 0.5 * acos(-1.0) && fabs(m->psi_p) <= m->phi_p &&
+         fabs(m->psi_r) <= m->phi_r && !isnan(m->sigma_t) &&
+         m->surface >= MPMC_MC_MOHR_COULOMB && m->surface <= MPMC_DP_PLANE_STRAIN &&
+         isfinite(m->K) && isfinite(m->G) && isfinite(m->c_p) && isfinite(m->eta);
+}
+
 /**
  * @brief c, phi and psi of the softened material at eps_p (return_mc.h).
  */
@@ -677,12 +698,7 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
   if (!info) info = &local;
   memset(info, 0, sizeof *info);
   if (!m || !eps_tr || !eps_p || !eps || !tau) return MPMC_ERR_ARG;
-  if (!(m->K > 0 && m->G > 0 && m->c_r >= 0 && m->c_p >= m->c_r && m->eta >= 0 &&
-        m->phi_p >= 0 && m->phi_r >= 0 && m->phi_p < 0.5 * acos(-1.0) && m->phi_r < 0.5 * acos(-1.0) &&
-        fabs(m->psi_p) <= m->phi_p && fabs(m->psi_r) <= m->phi_r && !isnan(m->sigma_t) &&
-        m->surface >= MPMC_MC_MOHR_COULOMB && m->surface <= MPMC_DP_PLANE_STRAIN &&
-        isfinite(m->K) && isfinite(m->G) && isfinite(m->c_p) && isfinite(m->eta)))
-    return MPMC_ERR_ARG;
+  if (!param_ok(m)) return MPMC_ERR_ARG;
   if (!(isfinite(eps_tr[0]) && isfinite(eps_tr[1]) && isfinite(eps_tr[2]) && isfinite(*eps_p) &&
         *eps_p >= 0))
     return MPMC_ERR_NUMERIC;
@@ -701,8 +717,9 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
   if (!(isfinite(S.str[0]) && isfinite(S.str[2]))) return MPMC_ERR_NUMERIC;
   S.tolf = mpmc_mc_tolerance(m, S.str);
   S.yscale = fmax(fabs(S.str[0]), fabs(S.str[2])) / m->G + 1e-300;
-  mc_mat q0;
-  mat_eval(m, e_of(m, S.ep0), 1, &q0);
+  S.e0 = e_of(m, S.ep0);
+  mat_eval(m, S.e0, 1, &S.q0);
+  const mc_mat q0 = S.q0;
   const double f0 = S.dp ? dp_f(&q0, S.str) : mc_f(&q0, S.str, 0, 2);
   double s[3], ep_new = S.ep0;
   if (f0 <= S.tolf && S.str[0] <= q0.st + S.tolf) { /* elastic */
@@ -732,13 +749,10 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
     if (err) return err;
     if (fail) continue;
     mc_sys Se = S;
-    if (perfect) {
-      Se.frozen = 1;
-      Se.e_frozen = e_of(m, S.ep0);
-    }
+    if (perfect) sys_freeze(&Se, S.e0);
     sys_eval(&Se, y, R, NULL, s);
-    mc_mat q;
-    mat_eval(m, perfect ? e_of(m, S.ep0) : e_of(m, S.ep0 + y[S.n]), 1, &q);
+    mc_mat q = S.q0;
+    if (!perfect) mat_eval(m, e_of(m, S.ep0 + y[S.n]), 1, &q);
     if (!admissible(&S, y, s, &q)) continue;
     found = 1;
     info->region = regs[r].region;
@@ -758,8 +772,8 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
     const double p = (S.str[0] + S.str[1] + S.str[2]) / 3.0;
     const double dv[3] = {S.str[0] - p, S.str[1] - p, S.str[2] - p};
     const double D = sqrt(2.0 / 3.0) * sqrt(dot3(dv, dv)) / (2.0 * m->G);
-    mc_mat q;
-    mat_eval(m, perfect ? e_of(m, S.ep0) : e_of(m, S.ep0 + D), 1, &q);
+    mc_mat q = S.q0;
+    if (!perfect) mat_eval(m, e_of(m, S.ep0 + D), 1, &q);
     /* the volume must shrink back (the apex is reached by a volumetric plastic expansion) */
     if (!isfinite(q.st) || !(p >= q.st - S.tolf)) return MPMC_ERR_SOLVER;
     s[0] = s[1] = s[2] = q.st;
@@ -779,24 +793,18 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
   return MPMC_SUCCESS;
 }
 
-/**
- * @brief The frictional return map of one point in tensor form (return_mc.h), by the
- * eigen-decomposition of the trial b_e (the principal directions are kept).
- * @param F     relative deformation gradient, or NULL when be is already the trial state
- * @param be    elastic left Cauchy-Green tensor (Voigt), in/out
- * @param eps_p accumulated plastic deviatoric strain, in/out
- * @param tau   Kirchhoff stress out (Voigt); J_out = sqrt(det b_e) (may be NULL)
- * @return 0, MPMC_ERR_NUMERIC (b_e not positive definite or not finite) or the principal
- *         return's code; on failure be, eps_p and tau are unchanged.
- */
-int mpmc_mc_return_map(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double F[3][3],
-                       double *be, double *eps_p, double *tau, double *J_out,
-                       mpmc_mc_info *info) {
-  double b[6], lam[3], Q[3][3], etr[3], e[3], t[3];
-  for (int k = 0; k < 6; ++k) b[k] = be[k];
-  if (F) mpmc_push_forward(F, b);
+/* The eigen path from the trial state: b its b_e, or (lg) eps = 1/2 ln b_e already formed by
+ * the series, whose eigen-decomposition gives the principal strains without three logs. */
+static int return_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double *b,
+                      int lg, double *be, double *eps_p, double *tau, double *J_out,
+                      mpmc_mc_info *info) {
+  double lam[3], Q[3][3], etr[3], e[3], t[3];
   mpmc_sym3_eig(b, lam, Q);
   for (int a = 0; a < 3; ++a) {
+    if (lg) {
+      etr[a] = lam[a];
+      continue;
+    }
     if (!(lam[a] > 0.0) || !isfinite(lam[a])) return MPMC_ERR_NUMERIC;
     etr[a] = 0.5 * log(lam[a]);
   }
@@ -808,6 +816,132 @@ int mpmc_mc_return_map(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, doubl
   if (J_out) *J_out = exp(e[0] + e[1] + e[2]);
   *eps_p = ep;
   return MPMC_SUCCESS;
+}
+
+/**
+ * @brief The frictional return map of one point in tensor form by the eigen-decomposition
+ * of the trial b_e for every point (return_mc.h; the principal directions are kept).
+ * @param F     relative deformation gradient, or NULL when be is already the trial state
+ * @param be    elastic left Cauchy-Green tensor (Voigt), in/out
+ * @param eps_p accumulated plastic deviatoric strain, in/out
+ * @param tau   Kirchhoff stress out (Voigt); J_out = sqrt(det b_e) (may be NULL)
+ * @return 0, MPMC_ERR_NUMERIC (b_e not positive definite or not finite) or the principal
+ *         return's code; on failure be, eps_p and tau are unchanged.
+ */
+int mpmc_mc_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double F[3][3],
+                           double *be, double *eps_p, double *tau, double *J_out,
+                           mpmc_mc_info *info) {
+  double b[6];
+  for (int k = 0; k < 6; ++k) b[k] = be[k];
+  if (F) mpmc_push_forward(F, b);
+  return return_eig(ws, solver, m, b, 0, be, eps_p, tau, J_out, info);
+}
+
+/**
+ * @brief The per-material part of the elastic check (return_mc.h): the peak strengths of
+ * mat_eval at eps_p = 0, the very values mpmc_mc_return_principal starts from.
+ */
+void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre) {
+  pre->m = *m;
+  pre->valid = param_ok(m);
+  pre->perfect = m->eta == 0.0 || (m->c_p == m->c_r && m->phi_p == m->phi_r && m->psi_p == m->psi_r);
+  mc_mat q;
+  mat_eval(m, e_of(m, 0.0), 1, &q);
+  pre->sf = q.sf;
+  pre->k = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
+  pre->eta = q.eta;
+  pre->gmax = sqrt(1.0 + q.sf * q.sf / 3.0);
+  pre->st = q.st;
+}
+
+/* The elastic check of the trial b without eigenvectors.  Hencky strain eps by the series,
+ * tau = K tr(eps) I + 2G dev(eps), p = tr(tau)/3, s = dev(tau), J2 = s:s / 2.  With the
+ * deviator's principal values s_k = 2 sqrt(J2/3) cos(a - 2 pi (k-1)/3) (s1 >= s2 >= s3 for
+ * a = acos((3 sqrt3 / 2) J3 / J2^(3/2)) / 3 in [0, pi/3]; J3 = det s):
+ *   Mohr-Coulomb  f = (s1 - s3) - s2 sin(phi) + 2p sin(phi) - 2c cos(phi), whose deviatoric
+ *     part is 2 sqrt(J2) (cos b - sin b sin(phi)/sqrt3), b = a - pi/6, at most
+ *     2 sqrt(J2) sqrt(1 + sin^2(phi)/3) (no trigonometry when that bound is enough);
+ *   Drucker-Prager f = sqrt(J2) + eta_f p - xi c;  cut-off p + s1 <= sigma_t, s1 <= 2 sqrt(J2/3).
+ * A point counts as elastic here only when every f is below -1e-6 of the stress scale: far
+ * beyond the round-off of either path (the trigonometric s_k lose ~1e-8 near repeated
+ * values), so that it is elastic in the eigen path too.  Returns 1 with be = b, tau, J
+ * written; 0 leaves the point to the eigen path (plastic, near a surface, or |eps| >~ 0.18),
+ * with eps in *eps_out (and 1 in *lg) when the series gave it. */
+static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, double *eps_out,
+                        int *lg, double *be, double *tau, double *J_out) {
+  const mpmc_mc_param *m = &pre->m;
+  double e[6];
+  *lg = 0;
+  if (mpmc_sym3_log_series(b, e)) return 0;
+  for (int k = 0; k < 6; ++k) eps_out[k] = e[k];
+  *lg = 1;
+  const double tr = e[0] + e[1] + e[2], G2 = 2.0 * m->G, p = m->K * tr;
+  for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
+  double s[6];
+  for (int k = 0; k < 6; ++k) s[k] = G2 * e[k];
+  const double j2 = 0.5 * mpmc_sym3_norm2(s), rj = sqrt(j2);
+  double sf = pre->sf, k = pre->k, eta = pre->eta, gmax = pre->gmax, st = pre->st;
+  if (!(pre->perfect || eps_p == 0.0)) {
+    mc_mat q;
+    mat_eval(m, e_of(m, eps_p), 1, &q);
+    sf = q.sf;
+    k = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
+    eta = q.eta;
+    gmax = sqrt(1.0 + sf * sf / 3.0);
+    st = q.st;
+  }
+  const double margin = 1e-6 * (fabs(p) + rj + k);
+  const int mc = m->surface == MPMC_MC_MOHR_COULOMB;
+  const double r3 = 1.7320508075688772;
+  int ok_f = mc ? 2.0 * rj * gmax + 2.0 * p * sf - k < -margin : rj + eta * p - k < -margin;
+  if (!mc && !ok_f) return 0; /* Drucker-Prager's f is exact: not elastic by the margin */
+  int ok_t = p + 2.0 * rj / r3 < st - margin;
+  if (!(ok_f && ok_t)) {
+    /* the largest and smallest principal deviatoric stresses from the invariants */
+    const double x = j2 > 0.0 ? 1.5 * r3 * mpmc_det_sym(s) / (j2 * rj) : 1.0;
+    const double a = acos(fmin(1.0, fmax(-1.0, x))) / 3.0, ca = cos(a), sa = sin(a);
+    const double R = 2.0 * rj / r3, s1 = R * ca, s3 = R * (-0.5 * ca - 0.5 * r3 * sa);
+    if (!ok_f) ok_f = (s1 - s3) + (2.0 * p + s1 + s3) * sf - k < -margin;
+    if (!ok_t) ok_t = p + s1 < st - margin;
+    if (!(ok_f && ok_t)) return 0;
+  }
+  for (int i = 0; i < 6; ++i) be[i] = b[i]; /* elastic: keep b_e as pushed forward */
+  for (int i = 0; i < 6; ++i) tau[i] = s[i];
+  for (int i = 0; i < 3; ++i) tau[i] += p;
+  if (J_out) *J_out = exp(tr);
+  return 1;
+}
+
+/**
+ * @brief The frictional return map of one point in tensor form (return_mc.h): the elastic
+ * check without eigenvectors (elastic_fast), the eigen path for the rest.
+ * @param pre   the material, from mpmc_mc_prepare
+ * Other parameters and the return value as mpmc_mc_return_map_eig's.
+ */
+int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[3][3],
+                   double *be, double *eps_p, double *tau, double *J_out, mpmc_mc_info *info) {
+  double b[6], eps[6];
+  int lg = 0;
+  for (int k = 0; k < 6; ++k) b[k] = be[k];
+  if (F) mpmc_push_forward(F, b);
+  if (pre->valid && *eps_p >= 0.0 && isfinite(*eps_p) &&
+      elastic_fast(pre, b, *eps_p, eps, &lg, be, tau, J_out)) {
+    if (info) memset(info, 0, sizeof *info);
+    return MPMC_SUCCESS;
+  }
+  return return_eig(ws, solver, &pre->m, lg ? eps : b, lg, be, eps_p, tau, J_out, info);
+}
+
+/**
+ * @brief The frictional return map of one point in tensor form (return_mc.h): mpmc_mc_update
+ * with the material prepared here (for the tests; a material's update prepares it once).
+ */
+int mpmc_mc_return_map(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double F[3][3],
+                       double *be, double *eps_p, double *tau, double *J_out,
+                       mpmc_mc_info *info) {
+  mpmc_mc_pre pre;
+  mpmc_mc_prepare(m, &pre);
+  return mpmc_mc_update(ws, solver, &pre, F, be, eps_p, tau, J_out, info);
 }
 
 /**

@@ -97,6 +97,37 @@ int mpmc_mc_return_map(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, doubl
                        double *be, double *eps_p, double *tau, double *J_out,
                        mpmc_mc_info *info);
 
+/* The same return by the eigen-decomposition of every trial b_e (the path of its plastic
+ * points): the reference the tests compare mpmc_mc_return_map with. */
+int mpmc_mc_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double F[3][3],
+                           double *be, double *eps_p, double *tau, double *J_out,
+                           mpmc_mc_info *info);
+
+/* What the elastic check of a point needs, worked out once per material (sines, cosines,
+ * the cut-off's cap) for the points that have not yielded (eps_p = 0, most of a slope) and
+ * for every point under perfect plasticity: mpmc_mc_prepare, then mpmc_mc_update per point. */
+typedef struct {
+  mpmc_mc_param m;
+  int valid;   /* m passes mpmc_mc_return_principal's checks (else every point takes the
+                  eigen path, which reports MPMC_ERR_ARG)                                */
+  int perfect; /* no softening: the peak values hold at every eps_p                    */
+  double sf;   /* Mohr-Coulomb: sin(phi_p)                                              */
+  double k;    /* Mohr-Coulomb: 2 c_p cos(phi_p); Drucker-Prager: xi(phi_p) c_p         */
+  double eta;  /* Drucker-Prager: eta_f(phi_p)                                          */
+  double gmax; /* Mohr-Coulomb: sqrt(1 + sin^2(phi_p) / 3), the largest (s1 - s3 - s2 sin
+                  phi) / (2 sqrt(J2)) over the Lode angle                                */
+  double st;   /* the cut-off at the peak, capped at the apex (INFINITY: none)          */
+} mpmc_mc_pre;
+
+void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre);
+
+/* The tensor-form return of one point (as mpmc_mc_return_map, which it is with pre of m):
+ * the elastic check from the series Hencky strain of linalg.h and the invariants, without
+ * an eigen-decomposition; the eigen path for the plastic points and those within round-off
+ * of a surface or beyond the series.  Returns what mpmc_mc_return_map does. */
+int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[3][3],
+                   double *be, double *eps_p, double *tau, double *J_out, mpmc_mc_info *info);
+
 void mpmc_mc_reduce(mpmc_mc_param *m, double factor);
 
 #endif
