@@ -62,7 +62,7 @@ module mpmc
   integer(c_int), parameter, public :: MPMC_SEED_LATTICE = 0, MPMC_SEED_QUADRATURE = 1
   ! mpmc_workflow_run flags
   integer(c_int), parameter, public :: MPMC_WORKFLOW_FORCE = 1, MPMC_WORKFLOW_QUIET = 2, &
-    MPMC_WORKFLOW_CHECK = 4
+    MPMC_WORKFLOW_CHECK = 4, MPMC_WORKFLOW_FOS = 8
   !> The run monitor's default energy factor (mpmc_sim_set_energy_monitor).
   real(c_double), parameter, public :: MPMC_MONITOR_ENERGY_FACTOR = 10.0_c_double
   !> The paper's strength reduction factor (landslide trigger), for mpmc_sim_reduce_strength.

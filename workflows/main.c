@@ -9,12 +9,15 @@
 static const char usage[] =
     "usage: mpmc run SCENE.yaml [--out DIR] [--set key.path=value ...] [--threads N] [--force] [--quiet]\n"
     "       mpmc check SCENE.yaml [--set key.path=value ...]\n"
+    "       mpmc fos SCENE.yaml [--out DIR] [--set key.path=value ...] [--threads N] [--force] [--quiet]\n"
     "       mpmc resume DIR [--set key.path=value ...] [--threads N] [--quiet]\n"
     "       mpmc models\n"
     "       mpmc --help | --version\n"
     "\n"
     "  run     run every stage of the scene; outputs go to DIR (default out/<scene>):\n"
     "          summary.json, series.csv, snapshots.h5/.xdmf, checkpoint.h5, PNG plots\n"
+    "  fos     the factor of safety: the scene's stages up to its factor_of_safety stage,\n"
+    "          which searches for it by strength reduction (summary.json, fos_trials.csv)\n"
     "  check   validate the scene (and the --set overrides) and print what would run\n"
     "  models  print the material models a scene may name, with their parameters (units,\n"
     "          ranges, defaults) as Markdown: the table of docs/materials.md\n"
@@ -111,7 +114,7 @@ int main(int argc, char **argv) {
     for (int k = 0; k < n; ++k) print_model(k);
     return 0;
   }
-  if (strcmp(cmd, "run") && strcmp(cmd, "check") && strcmp(cmd, "resume")) {
+  if (strcmp(cmd, "run") && strcmp(cmd, "check") && strcmp(cmd, "resume") && strcmp(cmd, "fos")) {
     fprintf(stderr, "mpmc: unknown command '%s'\n%s", cmd, usage);
     return 2;
   }
@@ -160,7 +163,9 @@ int main(int argc, char **argv) {
   if (!strcmp(cmd, "resume"))
     err = mpmc_workflow_resume_set(ctx, target, nset, sets, flags & MPMC_WORKFLOW_QUIET);
   else
-    err = mpmc_workflow_run(ctx, target, out, nset, sets, flags | (!strcmp(cmd, "check") ? MPMC_WORKFLOW_CHECK : 0));
+    err = mpmc_workflow_run(ctx, target, out, nset, sets,
+                            flags | (!strcmp(cmd, "check") ? MPMC_WORKFLOW_CHECK : 0) |
+                                (!strcmp(cmd, "fos") ? MPMC_WORKFLOW_FOS : 0));
   if (err) print_error(ctx, err);
   mpmc_context_destroy(&ctx);
   for (int i = 0; i < nowned; ++i) free(owned[i]);

@@ -258,7 +258,7 @@ static double jnum(double v) { return isfinite(v) ? v : 0.0; }
  *        metrics of the current state.  Nothing is written when path cannot be opened.
  */
 void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const char *error,
-                      const wf_stage_record *rec, int nstages_done, double wall) {
+                      const wf_stage_record *rec, int nstages_done, double wall, const wf_fos_result *fos) {
   const int ok = error == NULL;
   FILE *f = fopen(path, "w");
   if (!f) return;
@@ -304,10 +304,13 @@ void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const 
     const wf_stage_record *r = &rec[i];
     fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
     json_str(f, r->name);
-    fprintf(f, ", \"sim_time\": %.9g, \"steps\": %ld, \"wall_seconds\": %.6g, \"end\": \"%s\"}", r->sim_time,
-            r->steps, r->wall_seconds, r->reason ? r->reason : "failed");
+    fprintf(f, ", \"sim_time\": %.9g, \"steps\": %ld, \"wall_seconds\": %.6g, \"end\": \"%s\", "
+               "\"strength_reduction\": %.9g}",
+            r->sim_time, r->steps, r->wall_seconds, r->reason ? r->reason : "failed",
+            r->strength > 0 ? r->strength : 1.0);
   }
   fputs(nstages_done ? "\n  ]" : "]", f);
+  if (fos && fos->ntrial > 0) wf_fos_json(f, fos);
   double m[WF_METRIC_COUNT] = {0};
   if (sim && np > 0 && wf_metrics_compute(sim, sc, m) == 0)
     for (int k = 0; k < WF_METRIC_COUNT; ++k)

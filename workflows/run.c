@@ -53,6 +53,8 @@ typedef struct {
   double ckpt_time;        /* its simulated time                                          */
   int resumed;             /* outputs are the _resumed files                              */
   int series_rows;         /* data rows series.csv holds from before a resume            */
+  wf_fos_result *fos;      /* the factor-of-safety search's trials (a fos stage ran)      */
+  int fos_only;            /* stop after the factor-of-safety stage (`mpmc fos`)          */
 } wf_run;
 
 /* `threads` applies to every parallel region of the run (the step and the reductions the
@@ -150,7 +152,8 @@ static int run_output(const char *name) {
   static const char *const files[] = {"summary.json", "series.csv", "snapshots.h5", "snapshots.xdmf",
                                       "snapshots_resumed.h5", "snapshots_resumed.xdmf", "checkpoint.h5.tmp",
                                       "final_state.csv", "final_mean_stress.png", "final_eps_p.png", "series.png",
-                                      "bearing.png", "plots.log", "snapshot_plots.log", NULL};
+                                      "bearing.png", "plots.log", "snapshot_plots.log", "fos_trials.csv", "fos_base.h5",
+                                      NULL};
   for (int i = 0; files[i]; ++i) {
     const size_t l = strlen(files[i]);
     /* the file, or the temporary one it is written through (series.csv.tmp, checkpoint.h5.tmp,
@@ -448,8 +451,8 @@ static int checkpoint(wf_run *w, int stage, const stage_clock *c, long steps) {
   for (int i = 0; i < w->nwall_ids && l < sizeof meta; ++i)
     l += (size_t)snprintf(meta + l, sizeof meta - l, "wall %d\n", w->wall_ids[i]);
   for (int i = 0; i < stage && l < sizeof meta; ++i)
-    l += (size_t)snprintf(meta + l, sizeof meta - l, "done %.17g %ld %.17g %s\n", w->rec[i].sim_time,
-                          w->rec[i].steps, w->rec[i].wall_seconds, w->rec[i].reason);
+    l += (size_t)snprintf(meta + l, sizeof meta - l, "done %.17g %ld %.17g %s %.17g\n", w->rec[i].sim_time,
+                          w->rec[i].steps, w->rec[i].wall_seconds, w->rec[i].reason, w->rec[i].strength);
   if (l >= sizeof meta) return fail(w, MPMC_ERR_MEMORY, "checkpoint: too many overrides to record");
   WF_TRY(w, mpmc_sim_checkpoint_write(w->sim, path, meta), "checkpoint %s", path);
   w->ckpt_ok = 1;
@@ -590,6 +593,7 @@ static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf
   *nsteps = steps;
   rec->wall_seconds += wf_now() - w0;
   rec->reason = reason;
+  rec->strength = w->strength;
   wf_metrics_stage_end(sim, &w->sc, i); /* metrics kept from the end of this stage */
   if (snapshot(w)) return -1;
   if (!strcmp(reason, "max_time"))
@@ -597,6 +601,40 @@ static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf
         s->max_time, s->ke_ratio, ratio);
   say(w, "stage %d/%d %s done: %.4g s simulated in %ld steps, %.1f s wall (%s)", i + 1, sc->nstage, s->name,
       t_stage, rec->steps, rec->wall_seconds, reason);
+  return 0;
+}
+
+static void say_line(void *data, const char *line) { say((const wf_run *)data, "%s", line); }
+
+/* Stage i is a factor-of-safety search (fos.c): trials from the state at hand, which itself
+ * does not move; the stages after it go on from this state at the first failing factor. */
+static int run_fos(wf_run *w, int i) {
+  const double w0 = wf_now();
+  const wf_stage *s = &w->sc.stages[i];
+  wf_stage_record *rec = &w->rec[i];
+  snprintf(rec->name, sizeof rec->name, "%s", s->name);
+  if (!w->fos && !(w->fos = calloc(1, sizeof *w->fos))) return fail(w, MPMC_ERR_MEMORY, "factor of safety");
+  char msg[WF_MSG] = "";
+  say(w, "stage %d/%d %s: factor of safety between %g and %g to %g, trials of %g s, failure beyond %g m",
+      i + 1, w->sc.nstage, s->name, s->fos.lo, s->fos.hi, s->fos.tolerance, s->end_time, s->fos.displacement_limit);
+  const int e = wf_fos_search(w->ctx, w->sim, &w->sc, i, w->out, w->fos, w->quiet ? NULL : say_line, w, msg,
+                              sizeof msg);
+  if (e) return fail(w, e, "stage '%s': %s", s->name, msg);
+  char path[WF_PATH];
+  out_path(w, "fos_trials.csv", path, sizeof path);
+  if (wf_fos_write_csv(path, w->fos)) return fail(w, MPMC_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+  if (!w->fos->found) return fail(w, MPMC_ERR_NUMERIC, "stage '%s': %s", s->name, msg);
+  const double F = w->fos->hi;
+  WF_TRY(w, mpmc_sim_set_strength_reduction(w->sim, -1, F), "stages.%d: the first failing factor", i);
+  w->strength = F;
+  rec->sim_time = 0.0;
+  rec->steps = 0;
+  rec->wall_seconds += wf_now() - w0;
+  rec->reason = "fos";
+  rec->strength = F;
+  say(w, "stage %d/%d %s done: factor of safety %.4g (%g stands, %g fails), %d trials, %.1f s wall", i + 1,
+      w->sc.nstage, s->name, 0.5 * (w->fos->lo + w->fos->hi), w->fos->lo, w->fos->hi, w->fos->ntrial,
+      rec->wall_seconds);
   return 0;
 }
 
@@ -628,7 +666,12 @@ static int run_all(wf_run *w, int first_stage, const stage_clock *from, long ste
     /* the state the run starts from; a resumed run has it unless killed before writing it */
     if (i == 0 && t_stage == 0 && !setup_done && w->series_rows == 0 && series_row(w, i, steps, 0, 0, 1)) return -1;
     if (!(i == first_stage && t_stage > 0)) w->ke_below = -1.0; /* else restored from the checkpoint */
-    if (run_stage(w, i, i == first_stage ? from : NULL, &steps, &pr)) return -1;
+    if (w->sc.stages[i].has_fos) {
+      if (run_fos(w, i)) return -1;
+      if (w->fos_only) break; /* `mpmc fos`: the answer, without the stages after */
+    } else if (run_stage(w, i, i == first_stage ? from : NULL, &steps, &pr)) {
+      return -1;
+    }
 #ifdef MPMC_WF_HAVE_CHECKPOINT
     /* at the start of the next stage; after the last one, the finished run (stage = nstage),
      * which `mpmc resume` continues once the scene has another stage: that one only warns
@@ -649,7 +692,8 @@ static int finish(wf_run *w, int err) {
   if (!w->check && w->out[0]) {
     char path[WF_PATH];
     out_path(w, "summary.json", path, sizeof path);
-    wf_summary_write(path, &w->sc, w->sim, err == 0 ? NULL : w->status_msg, w->rec, done, wf_now() - w->t_start);
+    wf_summary_write(path, &w->sc, w->sim, err == 0 ? NULL : w->status_msg, w->rec, done, wf_now() - w->t_start,
+                     w->fos);
     if (err == 0 && w->sc.plots && w->sim) {
       char warn[WF_MSG] = "";
       if (wf_plots_write(w->sim, &w->sc, w->out, warn, sizeof warn)) say(w, "warning: plots: %s", warn);
@@ -664,6 +708,7 @@ static int finish(wf_run *w, int err) {
   mpmc_output_destroy(&w->snap);
   mpmc_sim_destroy(&w->sim);
   free(w->rec);
+  free(w->fos);
   free(w->wall_ids);
   wf_scene_free(&w->sc);
   return err;
@@ -696,11 +741,12 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
   MPMC_CHECK(scene && scene[0], ctx, MPMC_ERR_ARG, "scene file name is NULL or empty");
   MPMC_CHECK(noverride >= 0 && (noverride == 0 || overrides), ctx, MPMC_ERR_ARG,
              "noverride = %d with overrides = NULL", noverride);
-  MPMC_CHECK(flags >= 0 && flags < 8, ctx, MPMC_ERR_ARG, "flags = %d: unknown bits", flags);
+  MPMC_CHECK(flags >= 0 && flags < 16, ctx, MPMC_ERR_ARG, "flags = %d: unknown bits", flags);
   wf_run w = {0};
   w.ctx = ctx;
   w.quiet = (flags & MPMC_WORKFLOW_QUIET) != 0;
   w.check = (flags & MPMC_WORKFLOW_CHECK) != 0;
+  w.fos_only = (flags & MPMC_WORKFLOW_FOS) != 0;
   w.t_start = wf_now();
   w.strength = 1.0;
   w.noverride = noverride;
@@ -809,8 +855,12 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
         char reason[32];
         wf_stage_record *r = &done[ndone++];
         memset(r, 0, sizeof *r);
-        bad = sscanf(line, "done %lf %ld %lf %31s", &r->sim_time, &r->steps, &r->wall_seconds, reason) != 4;
-        r->reason = !strcmp(reason, "quasi_static") ? "quasi_static" : !strcmp(reason, "time") ? "time" : "max_time";
+        bad = sscanf(line, "done %lf %ld %lf %31s %lf", &r->sim_time, &r->steps, &r->wall_seconds, reason,
+                     &r->strength) != 5;
+        r->reason = !strcmp(reason, "quasi_static") ? "quasi_static"
+                    : !strcmp(reason, "time")       ? "time"
+                    : !strcmp(reason, "fos")        ? "fos"
+                                                    : "max_time";
       }
     }
   }

@@ -975,7 +975,10 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
   static const char *const keys[] = {"name", "gravity", "damping", "flip", "walls", "remove_walls", "tractions",
                                      "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
-                                     "snapshots", "series_points", "rigid_bodies", "force_dt", NULL};
+                                     "snapshots", "series_points", "rigid_bodies", "force_dt",
+                                     "factor_of_safety", NULL};
+  static const char *const fos_keys[] = {"lo", "hi", "tolerance", "displacement_limit", "growth", "max_trials",
+                                         NULL};
   static const char *const end_keys[] = {"time", "kinetic_energy_ratio", "max_time", "min_time", NULL};
   static const char *const tr_keys[] = {"set", "lo", "hi", "traction", NULL};
   for (int i = 0; i < ss->n; ++i) {
@@ -1050,6 +1053,26 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
           return fail_at(r, tr->items[k], tp, "a traction needs a particle set or a region lo/hi");
         if (get_vec(r, tr->items[k], tp, "traction", 1, sc->dim, ANY, t->traction)) return -1;
       }
+    }
+    const wf_node *fn = map_get(n, "factor_of_safety");
+    if (fn) {
+      /* a search: trials from this stage's start, each as long as its end (docs/workflows.md) */
+      join(full, sizeof full, p, "factor_of_safety");
+      if (check_map(r, fn, full, fos_keys)) return -1;
+      wf_fos *f = &s->fos;
+      s->has_fos = 1;
+      if (get_num(r, fn, full, "lo", 0, 1.0, POS, &f->lo) || get_num(r, fn, full, "hi", 0, 2.0, POS, &f->hi) ||
+          get_num(r, fn, full, "tolerance", 0, 0.01, POS, &f->tolerance) ||
+          get_num(r, fn, full, "displacement_limit", 1, 0, POS, &f->displacement_limit) ||
+          get_num(r, fn, full, "growth", 0, 0.05, UNIT, &f->growth) ||
+          get_int(r, fn, full, "max_trials", 0, 30, 2, 64, &f->max_trials))
+        return -1;
+      char hp[600];
+      join(hp, sizeof hp, full, "hi");
+      if (!(f->hi > f->lo)) return fail_at(r, fn, hp, "must be above lo = %g (got %g)", f->lo, f->hi);
+      if (map_get(n, "strength_reduction"))
+        return fail_at(r, map_get(n, "strength_reduction"), full,
+                       "a factor-of-safety stage sets its own factors: remove strength_reduction");
     }
     const wf_node *e = map_get(n, "end");
     join(full, sizeof full, p, "end");

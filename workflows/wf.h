@@ -101,6 +101,15 @@ typedef struct {
 } wf_traction;
 
 typedef enum { WF_END_TIME = 0, WF_END_QUASI_STATIC = 1 } wf_end_kind;
+/* A factor-of-safety search (fos.c): trials from the stage's start, each its end time long */
+typedef struct {
+  double lo, hi;             /* first bracket: lo expected to stand, hi to fail          */
+  double tolerance;          /* bisection until hi - lo <= tolerance                    */
+  double displacement_limit; /* [m] a trial fails when a point moves more than this      */
+  double growth;             /* ... or when its largest displacement still grows by more
+                                than this fraction over the trial's last quarter        */
+  int max_trials;
+} wf_fos;
 typedef struct {
   char name[WF_NAME];
   int has_gravity;
@@ -125,6 +134,8 @@ typedef struct {
   int series_points;         /* rows of series.csv for the stage                    */
   int nmotion;               /* rigid-body velocities set by the stage (rigid.c)    */
   wf_rigid_motion *motion;
+  int has_fos;               /* the stage is a factor-of-safety search (fos)        */
+  wf_fos fos;
 } wf_stage;
 
 typedef enum { WF_METRIC_RUNOUT, WF_METRIC_TIP_Y, WF_METRIC_TIP_X, WF_METRIC_COM_X,
@@ -203,15 +214,38 @@ typedef struct {
   char name[WF_NAME];
   double sim_time, wall_seconds;
   long steps;
-  const char *reason;        /* "time", "quasi_static", "max_time"; NULL: not done        */
+  const char *reason;        /* "time", "quasi_static", "max_time", "fos"; NULL: not done */
+  double strength;           /* the strength reduction factor in force at its end (1: none) */
 } wf_stage_record;
+
+/* ---- the factor-of-safety search (fos.c) ------------------------------------------ */
+typedef struct {
+  double factor, max_displacement, growth, ke_ratio, sim_time, wall_seconds;
+  long steps;
+  int failed;
+} wf_fos_trial;
+typedef struct {
+  int ntrial;
+  wf_fos_trial trial[64];
+  double lo, hi;             /* the final bracket: lo stood, hi failed                  */
+  int found;                 /* 1: bracketed to the tolerance                           */
+} wf_fos_result;
+/* The search of stage s from the state sim (set up for the stage), which it leaves as it is:
+ * the state is saved to outdir/fos_base.h5 and every trial starts from it.
+ * say(data, line) reports each trial.  0, or an mpmc error code with msg. */
+int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage, const char *outdir,
+                  wf_fos_result *res, void (*say)(void *data, const char *line), void *data, char *msg,
+                  size_t len);
+/* fos_trials.csv and summary.json's fos fields (report.c) */
+int wf_fos_write_csv(const char *path, const wf_fos_result *res);
+void wf_fos_json(FILE *f, const wf_fos_result *res);
 FILE *wf_series_open(const char *path, const wf_scene *sc, int append, char *msg, size_t len);
 int wf_series_row(FILE *f, mpmc_sim sim, const wf_scene *sc, int stage, long step, double dt, double ke,
                   double ratio);
 /* series.csv cut back to the rows of at most `steps` steps (resume); 0, or -1 with msg. */
 int wf_series_trim(const char *path, const wf_scene *sc, long steps, int *kept, char *msg, size_t len);
 void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const char *error,
-                      const wf_stage_record *rec, int nstages_done, double wall);
+                      const wf_stage_record *rec, int nstages_done, double wall, const wf_fos_result *fos);
 extern const char *const wf_metric_names[WF_METRIC_COUNT];
 /* Compute the enabled metrics of the current state into values[WF_METRIC_COUNT]. */
 int wf_metrics_compute(mpmc_sim sim, const wf_scene *sc, double *values);

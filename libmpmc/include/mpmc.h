@@ -472,6 +472,7 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
 #define MPMC_WORKFLOW_FORCE 1 /* write into an existing, non-empty outdir              */
 #define MPMC_WORKFLOW_QUIET 2 /* no log and no progress display                        */
 #define MPMC_WORKFLOW_CHECK 4 /* validate the scene and print the plan; run nothing     */
+#define MPMC_WORKFLOW_FOS 8   /* stop after the factor_of_safety stage (`mpmc fos`)     */
 /* Continue the run in outdir from its last checkpoint (`mpmc resume`); flags: QUIET.  A
  * finished run's checkpoint goes on once the scene has another stage or a later end for its
  * last one; with overrides (`mpmc resume DIR --set ...`) applied after the run's own. */

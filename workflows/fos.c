@@ -1,0 +1,206 @@
+/* The factor-of-safety search of a `factor_of_safety` stage (docs/workflows.md): the state at
+ * the stage's start (after gravity initialisation) is saved once; each trial factor F starts
+ * from it, divides every plastic material's strengths by F (mpmc_sim_set_strength_reduction:
+ * kappa for J2; c, tan phi, tan psi for the frictional models), and runs the stage's time
+ * with its damping.  The verdict, on the largest displacement d(t) of a point since the
+ * trial's start (lengths and simulated times only, so that it does not depend on the time
+ * step): the trial fails when d exceeds the stage's displacement_limit, or when d still grows
+ * at the end, by more than the fraction `growth` of d(T) over the last quarter of the trial
+ * (a slope that keeps moving has not found equilibrium; a stable one settles, its d
+ * converging).  The first
+ * bracket is widened (lo / 1.5, hi x 1.5) until lo stands and hi fails, then bisected until
+ * hi - lo <= tolerance.  The factor of safety reported is the bracket's midpoint. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "wf.h"
+
+#define FOS_CHECK_EVERY 20 /* steps between displacement checks (a trial stops when it fails) */
+
+/* largest |x - xs[id]| over the points (xs by point id: the sort moves points) */
+static double max_displacement(mpmc_sim sim, int dim, const double *xs) {
+  double *x;
+  const int *ids;
+  int n = 0;
+  if (mpmc_sim_get_num_particles(sim, &n) || mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
+      mpmc_sim_get_particle_ids(sim, &ids))
+    return NAN;
+  double m = 0.0;
+  for (int q = 0; q < n; ++q) {
+    double d2 = 0.0;
+    for (int a = 0; a < dim; ++a) {
+      const double dx = x[(size_t)q * dim + a] - xs[(size_t)ids[q] * dim + a];
+      d2 += dx * dx;
+    }
+    if (d2 > m) m = d2;
+  }
+  return sqrt(m);
+}
+
+/* the base state with the strengths divided by F, in *sim; its positions by id in *xs */
+static int open_trial(mpmc_context ctx, const char *base, const wf_scene *sc, double F, mpmc_sim *sim,
+                      double **xs) {
+  char *meta = NULL;
+  int e = mpmc_sim_checkpoint_read(ctx, base, sim, &meta);
+  mpmc_free(meta);
+  if (e) return e;
+  if (!e) e = mpmc_sim_set_threads(*sim, sc->threads);
+  if (!e) e = mpmc_sim_set_sort_interval(*sim, sc->sort_interval);
+  if (!e) e = mpmc_sim_set_strength_reduction(*sim, -1, F);
+  int n = 0;
+  double *x;
+  const int *ids;
+  if (!e) e = mpmc_sim_get_num_particles(*sim, &n);
+  if (!e) e = mpmc_sim_get_field(*sim, MPMC_FIELD_POSITION, &x, NULL);
+  if (!e) e = mpmc_sim_get_particle_ids(*sim, &ids);
+  if (!e && xs) {
+    *xs = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1) * (size_t)sc->dim);
+    if (!*xs) e = MPMC_ERR_MEMORY;
+    for (int q = 0; !e && q < n; ++q)
+      for (int a = 0; a < sc->dim; ++a) (*xs)[(size_t)ids[q] * sc->dim + a] = x[(size_t)q * sc->dim + a];
+  }
+  if (e) mpmc_sim_destroy(sim);
+  return e;
+}
+
+/* One trial: the stage's time at factor F from the base state. */
+static int run_trial(mpmc_context ctx, const char *base, const wf_scene *sc, const wf_stage *s, double F,
+                     wf_fos_trial *t, char *msg, size_t len) {
+  const double w0 = wf_now();
+  mpmc_sim sim = NULL;
+  double *xs = NULL;
+  int e = open_trial(ctx, base, sc, F, &sim, &xs);
+  if (e) {
+    snprintf(msg, len, "trial F = %g: cannot start from %s: %s", F, base, mpmc_context_last_error(ctx));
+    return e;
+  }
+  *t = (wf_fos_trial){.factor = F};
+  const double T = s->end_time, limit = s->fos.displacement_limit;
+  double ts = 0.0, dt = s->dt, ke = 0.0, ke_max = 0.0, disp = 0.0, d75 = -1.0;
+  long steps = 0;
+  while (ts < T * (1 - 1e-9)) {
+    if (s->dt <= 0 && (steps % 10 == 0)) e = mpmc_sim_stable_dt(sim, s->dt_factor, &dt);
+    double h = dt;
+    if (ts + h > T) h = T - ts;
+    if (!e) e = mpmc_sim_step(sim, h);
+    if (e) break;
+    ts += h;
+    ++steps;
+    if (steps % FOS_CHECK_EVERY == 0 || ts >= T * (1 - 1e-9)) {
+      mpmc_sim_get_kinetic_energy(sim, &ke);
+      if (ke > ke_max) ke_max = ke;
+      disp = max_displacement(sim, sc->dim, xs);
+      if (!(disp <= limit)) break; /* failed: no need to go on */
+      if (d75 < 0 && ts >= 0.75 * T) d75 = disp;
+    }
+  }
+  if (e) {
+    /* a numerical failure of a trial is reported, not taken for a verdict */
+    snprintf(msg, len, "trial F = %g at t = %g s of %g: %s", F, ts, T, mpmc_context_last_error(ctx));
+  } else {
+    t->max_displacement = disp;
+    t->growth = d75 >= 0 && disp > 0 ? (disp - d75) / disp : 0.0;
+    t->failed = !(disp <= limit) || t->growth > s->fos.growth;
+    t->ke_ratio = ke_max > 0 ? ke / ke_max : 0.0;
+    t->sim_time = ts;
+    t->steps = steps;
+  }
+  t->wall_seconds = wf_now() - w0;
+  free(xs);
+  mpmc_sim_destroy(&sim);
+  return e;
+}
+
+int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage, const char *outdir,
+                  wf_fos_result *res, void (*say)(void *data, const char *line), void *data, char *msg,
+                  size_t len) {
+  const wf_stage *s = &sc->stages[stage];
+  const wf_fos *f = &s->fos;
+  char base[WF_PATH + 32], line[512];
+  snprintf(base, sizeof base, "%s/fos_base.h5", outdir);
+  int e = mpmc_sim_checkpoint_write(sim, base, "mpmc-workflow fos base");
+  if (e) {
+    snprintf(msg, len, "cannot save the search's starting state: %s", mpmc_context_last_error(ctx));
+    return e;
+  }
+  memset(res, 0, sizeof *res);
+  double lo = f->lo, hi = f->hi;
+  int lo_ok = 0, hi_ok = 0; /* lo known to stand, hi known to fail */
+  while (res->ntrial < f->max_trials) {
+    double F;
+    if (!lo_ok)
+      F = lo;
+    else if (!hi_ok)
+      F = hi;
+    else if (hi - lo > f->tolerance)
+      F = 0.5 * (lo + hi);
+    else
+      break;
+    wf_fos_trial *t = &res->trial[res->ntrial];
+    e = run_trial(ctx, base, sc, s, F, t, msg, len);
+    if (e) return e;
+    res->ntrial++;
+    snprintf(line, sizeof line,
+             "factor of safety: trial %d, F = %.4f: %s (largest displacement %.4g m, limit %g m; grew %.3g "
+             "of it over the last quarter, limit %g; E_k/E_k,max %.3g; %ld steps, %.1f s)",
+             res->ntrial, F, t->failed ? "fails" : "stands", t->max_displacement, f->displacement_limit,
+             t->growth, f->growth, t->ke_ratio, t->steps, t->wall_seconds);
+    if (say) say(data, line);
+    if (!lo_ok) {
+      if (t->failed) {
+        hi = lo, hi_ok = 1; /* the lower guess fails: it bounds from above, look lower */
+        lo = lo / 1.5;
+      } else {
+        lo_ok = 1;
+      }
+    } else if (!hi_ok) {
+      if (t->failed) {
+        hi_ok = 1;
+      } else {
+        lo = hi; /* stands: widen upwards */
+        hi = hi * 1.5;
+      }
+    } else if (t->failed) {
+      hi = F;
+    } else {
+      lo = F;
+    }
+  }
+  res->lo = lo;
+  res->hi = hi;
+  res->found = lo_ok && hi_ok && hi - lo <= f->tolerance;
+  if (!res->found)
+    snprintf(msg, len, "no bracket of width %g after %d trials (lo %g %s, hi %g %s)", f->tolerance, res->ntrial, lo,
+             lo_ok ? "stands" : "not shown to stand", hi, hi_ok ? "fails" : "not shown to fail");
+  return 0;
+}
+
+int wf_fos_write_csv(const char *path, const wf_fos_result *res) {
+  FILE *f = fopen(path, "w");
+  if (!f) return MPMC_ERR_IO;
+  fputs("trial,factor,verdict,max_displacement,growth,ke_ratio,sim_time,steps,wall_seconds\n", f);
+  for (int i = 0; i < res->ntrial; ++i) {
+    const wf_fos_trial *t = &res->trial[i];
+    fprintf(f, "%d,%.9g,%s,%.9g,%.6g,%.6g,%.9g,%ld,%.6g\n", i + 1, t->factor, t->failed ? "fails" : "stands",
+            t->max_displacement, t->growth, t->ke_ratio, t->sim_time, t->steps, t->wall_seconds);
+  }
+  return fclose(f) ? MPMC_ERR_IO : 0;
+}
+
+void wf_fos_json(FILE *f, const wf_fos_result *res) {
+  if (res->found)
+    fprintf(f, ",\n  \"factor_of_safety\": %.6g", 0.5 * (res->lo + res->hi));
+  else
+    fputs(",\n  \"factor_of_safety\": null", f);
+  fprintf(f, ",\n  \"fos_bracket\": [%.6g, %.6g],\n  \"fos_trials\": [", res->lo, res->hi);
+  for (int i = 0; i < res->ntrial; ++i) {
+    const wf_fos_trial *t = &res->trial[i];
+    fprintf(f, "%s\n    {\"factor\": %.9g, \"verdict\": \"%s\", \"max_displacement\": %.9g, \"growth\": %.6g, "
+               "\"ke_ratio\": %.6g, \"steps\": %ld, \"wall_seconds\": %.6g}",
+            i ? "," : "", t->factor, t->failed ? "fails" : "stands", t->max_displacement, t->growth, t->ke_ratio,
+            t->steps, t->wall_seconds);
+  }
+  fputs(res->ntrial ? "\n  ]" : "]", f);
+}
