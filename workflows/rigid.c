@@ -9,7 +9,14 @@
  * and its load q = reaction[axis] / loaded_width are recorded; the ratio is the mean of
  * q/su over the steps whose settlement is at least `from` (default 1/2) of the final one,
  * i.e. over the second half of the settlement, where the load-displacement curve has
- * levelled off.  Prandtl: 2 + pi for a strip footing on weightless Tresca soil. */
+ * levelled off.  Prandtl: 2 + pi for a strip footing on weightless Tresca soil.
+ *
+ * The metric's `su` is the strength the load is divided by, the soil's cohesion in the
+ * Mohr-Coulomb failure criterion: su = kappa_p / sqrt(3) for hencky_j2 (Tresca's strength in
+ * plane strain), c for mohr_coulomb and drucker_prager (Prandtl's q/c = N_c(phi), 14.83 at
+ * phi = 20 degrees).  The column keeps the name q_over_su for every model.  When the scene
+ * has one material with such a strength, `su` must equal it (an override of the material's
+ * strength without the metric's would report a ratio to the wrong strength). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -70,6 +77,25 @@ int wf_rigid_before_step(mpmc_sim sim, const wf_scene *sc, int stage, double t_s
   return 0;
 }
 
+/* The strength q is divided by (see the top of the file) of the scene's one material that
+ * has one, in *s with the key's name; 0 when none or several have one. */
+static int soil_strength(const wf_scene *sc, double *s, const char **key) {
+  int found = 0;
+  for (int i = 0; i < sc->nmat; ++i) {
+    const wf_material *mat = &sc->mats[i];
+    for (int k = 0; k < mat->npar; ++k) {
+      mpmc_param_info pi;
+      if (mpmc_model_get_param(mat->model, k, &pi)) continue;
+      if (!strcmp(pi.name, "kappa_p")) *s = mat->par[k] / sqrt(3.0), *key = "su = kappa_p / sqrt(3)";
+      else if (!strcmp(pi.name, "c")) *s = mat->par[k], *key = "c";
+      else continue;
+      ++found;
+      break;
+    }
+  }
+  return found == 1;
+}
+
 /** @brief Record the footing's settlement and load after a step (bearing_capacity_ratio). */
 int wf_rigid_after_step(mpmc_sim sim, const wf_scene *sc, char *msg, size_t len) {
   const wf_metrics *m = &sc->metrics;
@@ -79,6 +105,14 @@ int wf_rigid_after_step(mpmc_sim sim, const wf_scene *sc, char *msg, size_t len)
     b = calloc(1, sizeof *b);
     if (!b) return snprintf(msg, len, "bearing_capacity_ratio: out of memory"), MPMC_ERR_MEMORY;
     ((wf_scene *)sc)->metrics.bearing = b; /* the record is run-time state, not scene input */
+    double s;
+    const char *key;
+    if (soil_strength(sc, &s, &key) && fabs(s - m->bearing_su) > 1e-9 * s)
+      return snprintf(msg, len,
+                      "metrics.bearing_capacity_ratio.su = %g Pa is not the soil's strength (%s = %g Pa): "
+                      "the ratio divides by it, set the two alike",
+                      m->bearing_su, key, s),
+             MPMC_ERR_ARG;
   }
   if (b->n == b->cap) {
     const int cap = b->cap ? 2 * b->cap : 4096;
