@@ -46,6 +46,9 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
   for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
   if (plastic && mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
   *has_eps = eps != NULL;
+  /* the return region of the frictional models (docs/materials.md), last column */
+  double *region = NULL;
+  if (mpmc_sim_get_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
   const int d = sc->dim;
   depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
   FILE *f = fopen(path, "w");
@@ -60,13 +63,15 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
     order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
   }
   if (d == 3) qsort(order, (size_t)np, sizeof *order, by_depth);
-  fprintf(f, d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz\n" : "x,y,mean_stress,eps_p,ux,uy\n");
+  fprintf(f, "%s%s\n", d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz" : "x,y,mean_stress,eps_p,ux,uy",
+          region ? ",region" : "");
   for (int k = 0; k < np; ++k) {
     const size_t q = (size_t)order[k].q;
     const double p = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3.0;
     for (int a = 0; a < d; ++a) fprintf(f, "%.7g,", x[q * d + a]);
     fprintf(f, "%.7g,%.7g", p, eps ? eps[q] : 0.0);
     for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - x0[q * d + a]);
+    if (region) fprintf(f, ",%d", (int)region[q]);
     fputc('\n', f);
   }
   free(order);
