@@ -19,6 +19,7 @@
 
 #include "linalg.h"
 #include "return_cpp.h"
+#include "return_mc.h"
 #include "return_map.h"
 #include "test_util.h"
 
@@ -288,6 +289,55 @@ static void test_drucker_prager(void **state) {
   mpmc_rm_ws_destroy(&ws);
 }
 
+/* Drucker-Prager as a user surface against the built-in model (return_mc.c, the compression
+ * cone of mpmc_sim_add_material_drucker_prager): sqrt(J2) = q / sqrt(3), so the built-in
+ * f = sqrt(J2) + eta_f p - xi c is the user's q + a p - k with a = sqrt(3) eta_f =
+ * 6 sin(phi) / (3 - sin(phi)), k = 6 c cos(phi) / (3 - sin(phi)), b likewise from psi.  Trial
+ * states from random principal Hencky strains; the cone region only (the user surface has no
+ * apex return). */
+static void test_dp_matches_builtin(void **state) {
+  (void)state;
+  mpmc_rm_ws *ws;
+  TCALL(mpmc_rm_ws_create(&ws));
+  int ncone = 0;
+  for (int q = 0; q < 3000; ++q) {
+    const double E = loguni(1e6, 1e9), nu = 0.45 * urand();
+    const double G = E / (2 * (1 + nu)), K = E / (3 * (1 - 2 * nu));
+    const double phi = 0.7 * urand(), psi = q % 2 ? phi : phi * urand(), c = E * loguni(1e-5, 1e-2);
+    const mpmc_mc_param mp = {.K = K, .G = G, .c_p = c, .c_r = c, .phi_p = phi, .phi_r = phi,
+                              .psi_p = psi, .psi_r = psi, .eta = 0.0, .sigma_t = INFINITY,
+                              .surface = MPMC_DP_COMPRESSION};
+    const dp_user u = {.a = 6 * sin(phi) / (3 - sin(phi)), .b = 6 * sin(psi) / (3 - sin(psi)),
+                       .k = 6 * c * cos(phi) / (3 - sin(phi))};
+    double etr[3], eps[3], tb[3], ep = 0.0;
+    const double s = c / E * loguni(0.1, 100);
+    for (int a = 0; a < 3; ++a) etr[a] = s * (2 * urand() - 1) - 0.3 * s;
+    mpmc_mc_info mi = {0};
+    TCALL(mpmc_mc_return_principal(ws, MPMC_SOLVER_AUTO, &mp, etr, &ep, eps, tb, &mi));
+    if (mi.region != MPMC_MC_PLANE) continue;
+    const double tr = etr[0] + etr[1] + etr[2];
+    double ttr[6] = {0}, tau[6], alpha = 0.0;
+    for (int a = 0; a < 3; ++a) ttr[a] = K * tr + 2 * G * (etr[a] - tr / 3);
+    double sd[6];
+    if (!(sqrt(1.5) * dev(ttr, sd) > 0)) continue;
+    const mpmc_cpp_param p = {.K = K, .G = G, .fn = dp_fn, .data = (void *)&u};
+    mpmc_cpp_info info;
+    const int err = mpmc_cpp_return_stress(ws, MPMC_SOLVER_AUTO, &p, ttr, &alpha, tau, &info);
+    if (err) fail_msg("state %d: %s", q, info.message);
+    ++ncone;
+    const double ts = fmax(fmax(fabs(ttr[0]), fabs(ttr[1])), fmax(fabs(ttr[2]), c));
+    double d = 0.0;
+    for (int a = 0; a < 3; ++a) d = fmax(d, fabs(tau[a] - tb[a]) / ts);
+    for (int k = 3; k < 6; ++k) d = fmax(d, fabs(tau[k]) / ts);
+    if (!(d <= 1e-10))
+      fail_msg("state %d (phi %g, psi %g): user and built-in Drucker-Prager differ by %.3g of the "
+               "stress (expected <= 1e-10): %.17g %.17g %.17g vs %.17g %.17g %.17g",
+               q, phi, psi, d, tau[0], tau[1], tau[2], tb[0], tb[1], tb[2]);
+  }
+  if (ncone < 500) fail_msg("only %d cone returns of 3000 (expected >= 500)", ncone);
+  mpmc_rm_ws_destroy(&ws);
+}
+
 /* ---- faults ---------------------------------------------------------------------------- */
 /* A J2 state well outside the surface, and the built-in's answer. */
 static void j2_fault_case(j2_user *u, double *ttr, double *tau_ref, double *ep_ref) {
@@ -433,6 +483,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_j2_matches_builtin), cmocka_unit_test(test_lapack_flag),
       cmocka_unit_test(test_drucker_prager),     cmocka_unit_test(test_wrong_derivatives),
+      cmocka_unit_test(test_dp_matches_builtin),
       cmocka_unit_test(test_user_errors),        cmocka_unit_test(test_elastic),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
