@@ -186,6 +186,7 @@ module mpmc
   public :: mpmc_output_write, mpmc_output_destroy, mpmc_free
   ! ---- public procedures: Fortran wrappers (strings, zero-copy arrays) -------------------
   public :: mpmc_error_string, mpmc_context_last_error, mpmc_context_get_last_error
+  public :: mpmc_context_get_last_code, mpmc_context_set_error
   public :: mpmc_phase_name, mpmc_kernels_name
   public :: mpmc_sim_get_field, mpmc_sim_restore_field, mpmc_sim_get_material_ids, &
     mpmc_sim_get_particle_ids, mpmc_sim_get_user_state
@@ -244,6 +245,21 @@ module mpmc
     function mpmc_context_clear_error(ctx) bind(C, name='mpmc_context_clear_error') result(ierr)
       import :: c_int, mpmc_context
       type(mpmc_context), value :: ctx
+      integer(c_int) :: ierr
+    end function
+    function mpmc_context_get_last_code(ctx, code) &
+        bind(C, name='mpmc_context_get_last_code') result(ierr)
+      import :: c_int, mpmc_context
+      type(mpmc_context), value :: ctx
+      integer(c_int), intent(out) :: code
+      integer(c_int) :: ierr
+    end function
+    function mpmc_context_set_error_c(ctx, code, file, line, message) &
+        bind(C, name='mpmc_context_set_error') result(ierr)
+      import :: c_int, c_char, mpmc_context
+      type(mpmc_context), value :: ctx
+      integer(c_int), value :: code, line
+      character(kind=c_char), intent(in) :: file(*), message(*)
       integer(c_int) :: ierr
     end function
     function mpmc_context_set_log_level(ctx, level) &
@@ -1243,6 +1259,16 @@ contains
       allocate (idx(0)) ! an empty set
     end if
   end function mpmc_sim_get_particle_set
+
+  !> Record an error in the context as the library does (e.g. from a user material's
+  !> callback); returns code.
+  function mpmc_context_set_error(ctx, code, file, line, message) result(ierr)
+    type(mpmc_context), intent(in) :: ctx
+    integer(c_int), intent(in) :: code, line
+    character(*), intent(in) :: file, message
+    integer(c_int) :: ierr
+    ierr = mpmc_context_set_error_c(ctx, code, mpmc_c_str(file), line, mpmc_c_str(message))
+  end function mpmc_context_set_error
 
   function mpmc_sim_find_particle_set(sim, name, id) result(ierr)
     type(mpmc_sim), intent(in) :: sim

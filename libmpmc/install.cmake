@@ -1,6 +1,6 @@
 # Install rules and the package files (included at the end of the top-level CMakeLists.txt):
 #   lib/libmpmc.so (+ libmpmc_fortran.so with include/mpmc.mod, libmpmc_workflow.so,
-#   libmpmc_gmsh.so and bin/mpmc when built), include/mpmc.h,
+#   libmpmc_gmsh.so and bin/mpmc when built), include/mpmc.h (+ mpmc_workflow.h, mpmc_gmsh.h),
 #   lib/cmake/mpmc/{mpmcConfig,mpmcConfigVersion,mpmcTargets}.cmake exporting mpmc::mpmc,
 #   mpmc::mpmc_fortran, mpmc::mpmc_workflow, mpmc::mpmc_gmsh,
 #   lib/pkgconfig/mpmc.pc (and mpmc-fortran.pc).
@@ -36,6 +36,12 @@ install(TARGETS ${MPMC_INSTALL_TARGETS} EXPORT mpmcTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${PROJECT_SOURCE_DIR}/libmpmc/include/mpmc.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# the optional libraries' headers, with their libraries
+foreach(t gmsh workflow)
+  if(TARGET mpmc_${t})
+    install(FILES ${PROJECT_SOURCE_DIR}/libmpmc/include/mpmc_${t}.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  endif()
+endforeach()
 
 if(TARGET mpmc_fortran)
   # the compiled module interface: compiler-specific, installed beside mpmc.h

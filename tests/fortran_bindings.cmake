@@ -1,7 +1,10 @@
-# t013-fortran-bindings: every function declared in the public header libmpmc/include/mpmc.h
+# t013-fortran-bindings: every function declared in the public headers libmpmc/include/*.h
 # has a bind(C, name='...') interface of the same name in fortran/mpmc.f90, so a function
 # added to the C API without its Fortran binding fails the suite.  Included by
-# tests/CMakeLists.txt; run in script mode (cmake -DHEADER=... -DMODULE=... -P) as the check.
+# tests/CMakeLists.txt; run in script mode (cmake -DHEADERS=a.h,b.h -DMODULE=... -P) as the
+# check.  The headers are parsed by libmpmc/public_api.cmake, as for the libraries' exports.
+# t014-exported-symbols: each shared library exports exactly the functions of its public
+# header (libmpmc: mpmc.h, libmpmc_gmsh: mpmc_gmsh.h, libmpmc_workflow: mpmc_workflow.h).
 if(CMAKE_SCRIPT_MODE_FILE)
   cmake_policy(VERSION 3.25) # the project's minimum (IN_LIST)
   # Functions that have no binding of their own, each with the reason:
@@ -10,22 +13,13 @@ if(CMAKE_SCRIPT_MODE_FILE)
   #    function of the same name that copies the message through mpmc_context_get_last_error.
   set(NOT_BOUND mpmc_context_last_error)
 
-  file(READ ${HEADER} header)
+  include(${CMAKE_CURRENT_LIST_DIR}/../libmpmc/public_api.cmake)
+  string(REPLACE "," ";" HEADERS "${HEADERS}")
+  mpmc_public_functions(functions ${HEADERS})
   file(READ ${MODULE} module)
-  # comments out (a commented-out prototype is no function), then one declaration a line:
-  # a function is a return type at the start of a line followed by its name and "("
-  string(REGEX REPLACE "/\\*([^*]|\\*+[^*/])*\\*+/" "" header "${header}")
-  string(REGEX REPLACE "//[^\n]*" "" header "${header}")
-  string(REGEX MATCHALL "(^|\n)(const )?[a-z_]+[ *]+mpmc_[a-z0-9_]+\\(" decls "${header}")
-  set(functions)
-  foreach(d IN LISTS decls)
-    string(REGEX MATCH "mpmc_[a-z0-9_]+" name "${d}")
-    list(APPEND functions ${name})
-  endforeach()
-  list(REMOVE_DUPLICATES functions)
   list(LENGTH functions nfun)
   if(nfun LESS 50)
-    message(FATAL_ERROR "expected the ~90 functions of ${HEADER}, found ${nfun}: ${functions}")
+    message(FATAL_ERROR "expected the ~100 functions of ${HEADERS}, found ${nfun}: ${functions}")
   endif()
   string(TOLOWER "${module}" module_lc)
   set(missing)
@@ -40,18 +34,44 @@ if(CMAKE_SCRIPT_MODE_FILE)
   endforeach()
   foreach(f IN LISTS NOT_BOUND)
     if(NOT f IN_LIST functions)
-      message(FATAL_ERROR "the exclusion ${f} is no longer a function of ${HEADER}: drop it")
+      message(FATAL_ERROR "the exclusion ${f} is no longer a function of ${HEADERS}: drop it")
     endif()
   endforeach()
   if(missing)
     string(REPLACE ";" ", " missing "${missing}")
     message(FATAL_ERROR "expected a bind(C, name='...') interface in ${MODULE} for every "
-      "function of ${HEADER}; none for: ${missing}")
+      "function of ${HEADERS}; none for: ${missing}")
   endif()
   return()
 endif()
 
+file(GLOB MPMC_PUBLIC_HEADERS ${PROJECT_SOURCE_DIR}/libmpmc/include/*.h)
+list(JOIN MPMC_PUBLIC_HEADERS "," MPMC_PUBLIC_HEADERS)
 add_test(NAME t013-fortran-bindings
-  COMMAND ${CMAKE_COMMAND} -DHEADER=${PROJECT_SOURCE_DIR}/libmpmc/include/mpmc.h
+  COMMAND ${CMAKE_COMMAND} -DHEADERS=${MPMC_PUBLIC_HEADERS}
     -DMODULE=${PROJECT_SOURCE_DIR}/fortran/mpmc.f90 -P ${CMAKE_CURRENT_LIST_FILE})
 set_tests_properties(t013-fortran-bindings PROPERTIES LABELS "unit;fortran")
+
+# t014-exported-symbols-<lib> (shared libraries only): `nm -D --defined-only` of the library
+# against the functions of its public header.  workflows/ is added after tests/: its target
+# is named here and resolved at generate time.
+if(BUILD_SHARED_LIBS AND CMAKE_NM)
+  set(libs mpmc)
+  if(TARGET mpmc_gmsh)
+    list(APPEND libs mpmc_gmsh)
+  endif()
+  if(EXISTS ${PROJECT_SOURCE_DIR}/workflows/CMakeLists.txt)
+    list(APPEND libs mpmc_workflow)
+  endif()
+  foreach(lib IN LISTS libs)
+    set(header ${lib}.h)
+    if(lib STREQUAL "mpmc")
+      set(header mpmc.h)
+    endif()
+    add_test(NAME t014-exported-symbols-${lib}
+      COMMAND ${CMAKE_COMMAND} -DMODE=check -DNM=${CMAKE_NM}
+        -DHEADERS=${PROJECT_SOURCE_DIR}/libmpmc/include/${header} -DLIBRARY=$<TARGET_FILE:${lib}>
+        -P ${PROJECT_SOURCE_DIR}/libmpmc/public_api.cmake)
+    set_tests_properties(t014-exported-symbols-${lib} PROPERTIES LABELS unit)
+  endforeach()
+endif()

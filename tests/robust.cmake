@@ -11,8 +11,8 @@ add_executable(fuzz_scene_replay ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/replay.c
   ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_scene.c)
 target_include_directories(fuzz_scene_replay PRIVATE ${PROJECT_SOURCE_DIR}/workflows
   ${PROJECT_SOURCE_DIR}/libmpmc/src)
-# the loader's private functions (wf_scene_load) come from libmpmc_workflow
-target_link_libraries(fuzz_scene_replay PRIVATE mpmc_workflow mpmc m)
+# the loader's own functions (wf_scene_load), hidden in libmpmc_workflow
+target_link_libraries(fuzz_scene_replay PRIVATE mpmc_workflow_internal mpmc m)
 add_test(NAME fuzz-scene-replay COMMAND fuzz_scene_replay ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/corpus)
 set_tests_properties(fuzz-scene-replay PROPERTIES LABELS unit)
 

@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include "test_util.h"
+#include "mpmc_gmsh.h"
 
 #define MESH(name) MPMC_SOURCE_DIR "/meshes/" name
 

@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "test_util.h"
+#include "mpmc_gmsh.h"
 
 static void test_slope_3d(void **state) {
   (void)state;

@@ -17,6 +17,7 @@
 #include <cmocka.h>
 
 #include "test_util.h"
+#include "mpmc_workflow.h"
 
 #define DIR MPMC_BINARY_DIR "/t690"
 

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "mpmc.h"
+#include "mpmc_workflow.h"
 
 static const char usage[] =
     "usage: mpmc run SCENE.yaml [--out DIR] [--set key.path=value ...] [--threads N] [--force] [--quiet]\n"

@@ -16,8 +16,37 @@
 #include <omp.h>
 #endif
 
-#include "mpmc_impl.h"
 #include "wf.h"
+
+/* Errors recorded in the context through the public API, as the core records its own:
+ * WF_ERROR formats the message, WF_CHECK returns it from the calling function on failure,
+ * WF_CALL propagates a non-zero code. */
+__attribute__((format(printf, 5, 6)))
+static int wf_error_at(mpmc_context ctx, int code, const char *file, int line, const char *fmt, ...) {
+  char body[3840]; /* the core's message buffer less room for the code's text and file:line */
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(body, sizeof body, fmt, ap);
+  va_end(ap);
+  return ctx ? mpmc_context_set_error(ctx, code, file, line, body) : code;
+}
+#define WF_ERROR(ctx, code, ...) wf_error_at((ctx), (code), __FILE__, __LINE__, __VA_ARGS__)
+#define WF_CHECK(cond, ctx, code, ...)                                          \
+  do {                                                                          \
+    if (!(cond)) return wf_error_at((ctx), (code), __FILE__, __LINE__, __VA_ARGS__); \
+  } while (0)
+#define WF_CALL(expr)              \
+  do {                             \
+    int wf_ierr_ = (expr);         \
+    if (wf_ierr_) return wf_ierr_; \
+  } while (0)
+
+/* The code of the context's last error. */
+static int last_code(mpmc_context ctx) {
+  int code = MPMC_ERR_ARG;
+  mpmc_context_get_last_code(ctx, &code);
+  return code;
+}
 
 /* Where a stage stands between two steps: what a checkpoint inside the stage records so that
  * the resumed stage takes the same steps as the uninterrupted one (the step size is computed
@@ -92,7 +121,7 @@ static int fail(wf_run *w, int code, const char *fmt, ...) {
   vsnprintf(body, sizeof body, fmt, ap);
   va_end(ap);
   snprintf(w->status_msg, sizeof w->status_msg, "%s", body);
-  return MPMC_ERROR(w->ctx, code, "%s", body);
+  return WF_ERROR(w->ctx, code, "%s", body);
 }
 
 /* Wrap a library call: on failure keep the library's message and add what we were doing. */
@@ -482,7 +511,7 @@ static int checkpoint(wf_run *w, int stage, const stage_clock *c, long steps) {
  * cost a full copy of the particles per step.  The failing state is appended to the
  * snapshots for inspection. */
 static int step_failed(wf_run *w, int e, const wf_stage *s, double t, long steps) {
-  char lib[MPMC_MSG_LEN], note[2 * WF_PATH + 256] = "";
+  char lib[4096] /* the core's message buffer */, note[2 * WF_PATH + 256] = "";
   snprintf(lib, sizeof lib, "%s", mpmc_context_last_error(w->ctx));
   if (w->ckpt_ok)
     snprintf(note, sizeof note,
@@ -752,10 +781,10 @@ static int prepare(wf_run *w, const char *scene, int noverride, const char *cons
 int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, int noverride,
                       const char *const *overrides, int flags) {
   if (!ctx) return MPMC_ERR_ARG;
-  MPMC_CHECK(scene && scene[0], ctx, MPMC_ERR_ARG, "scene file name is NULL or empty");
-  MPMC_CHECK(noverride >= 0 && (noverride == 0 || overrides), ctx, MPMC_ERR_ARG,
+  WF_CHECK(scene && scene[0], ctx, MPMC_ERR_ARG, "scene file name is NULL or empty");
+  WF_CHECK(noverride >= 0 && (noverride == 0 || overrides), ctx, MPMC_ERR_ARG,
              "noverride = %d with overrides = NULL", noverride);
-  MPMC_CHECK(flags >= 0 && flags < 16, ctx, MPMC_ERR_ARG, "flags = %d: unknown bits", flags);
+  WF_CHECK(flags >= 0 && flags < 16, ctx, MPMC_ERR_ARG, "flags = %d: unknown bits", flags);
   wf_run w = {0};
   w.ctx = ctx;
   w.quiet = (flags & MPMC_WORKFLOW_QUIET) != 0;
@@ -765,7 +794,7 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
   w.strength = 1.0;
   w.noverride = noverride;
   w.overrides = overrides;
-  if (prepare(&w, scene, noverride, overrides)) return finish(&w, mpmc_context_last_error(ctx)[0] ? ctx->last_code : MPMC_ERR_ARG);
+  if (prepare(&w, scene, noverride, overrides)) return finish(&w, mpmc_context_last_error(ctx)[0] ? last_code(ctx) : MPMC_ERR_ARG);
   if (outdir && outdir[0])
     snprintf(w.out, sizeof w.out, "%s", outdir);
   else
@@ -786,7 +815,7 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
   snprintf(out_saved, sizeof out_saved, "%s", w.out);
   w.out[0] = '\0';
   set_threads(&w);
-  if (build(&w)) return finish(&w, ctx->last_code);
+  if (build(&w)) return finish(&w, last_code(ctx));
   snprintf(w.out, sizeof w.out, "%s", out_saved);
   log_plan(&w);
   if (w.check) {
@@ -794,11 +823,11 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
     return finish(&w, 0);
   }
   if (mkdir_p(w.out)) return finish(&w, fail(&w, MPMC_ERR_IO, "cannot create '%s': %s", w.out, strerror(errno)));
-  if ((flags & MPMC_WORKFLOW_FORCE) && remove_old_outputs(&w)) return finish(&w, ctx->last_code);
+  if ((flags & MPMC_WORKFLOW_FORCE) && remove_old_outputs(&w)) return finish(&w, last_code(ctx));
   say(&w, "output: %s", w.out);
-  if (open_outputs(&w, 0)) return finish(&w, ctx->last_code);
+  if (open_outputs(&w, 0)) return finish(&w, last_code(ctx));
   const int err = run_all(&w, 0, NULL, 0, 0);
-  return finish(&w, err ? ctx->last_code : 0);
+  return finish(&w, err ? last_code(ctx) : 0);
 }
 
 /**
@@ -817,20 +846,20 @@ int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags) {
 int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride, const char *const *overrides,
                              int flags) {
   if (!ctx) return MPMC_ERR_ARG;
-  MPMC_CHECK(outdir && outdir[0], ctx, MPMC_ERR_ARG, "output directory outdir is NULL or empty");
-  MPMC_CHECK(noverride >= 0 && (noverride == 0 || overrides), ctx, MPMC_ERR_ARG,
+  WF_CHECK(outdir && outdir[0], ctx, MPMC_ERR_ARG, "output directory outdir is NULL or empty");
+  WF_CHECK(noverride >= 0 && (noverride == 0 || overrides), ctx, MPMC_ERR_ARG,
              "resume: noverride = %d with overrides %s", noverride, overrides ? "given" : "NULL");
   for (int i = 0; i < noverride; ++i)
-    MPMC_CHECK(overrides[i], ctx, MPMC_ERR_ARG, "resume: override %d is NULL", i);
+    WF_CHECK(overrides[i], ctx, MPMC_ERR_ARG, "resume: override %d is NULL", i);
 #ifndef MPMC_WF_HAVE_CHECKPOINT
   (void)flags;
-  return MPMC_ERROR(ctx, MPMC_ERR_UNSUPPORTED, "resume: this build has no checkpoints (checkpoint.c)");
+  return WF_ERROR(ctx, MPMC_ERR_UNSUPPORTED, "resume: this build has no checkpoints (checkpoint.c)");
 #else
   char path[WF_PATH];
   snprintf(path, sizeof path, "%s/checkpoint.h5", outdir);
   mpmc_sim sim = NULL;
   char *meta = NULL;
-  MPMC_CALL(mpmc_sim_checkpoint_read(ctx, path, &sim, &meta));
+  WF_CALL(mpmc_sim_checkpoint_read(ctx, path, &sim, &meta));
   /* parse the workflow's record */
   char scene[WF_PATH] = "";
   int stage = -1, setup = 0, nset = 0, nwall = 0, ndone = 0;
@@ -894,9 +923,9 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   /* the walls the checkpoint records: those of its stages, or of more (not yet added) */
   int walls_before = 0; /* of the stages up to the one resumed */
   if (bad || stage < 0 || !scene[0]) {
-    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "resume: %s was not written by the workflow (no stage record)", path);
+    err = WF_ERROR(ctx, MPMC_ERR_FORMAT, "resume: %s was not written by the workflow (no stage record)", path);
   } else if (prepare(&w, scene, nset, w.overrides)) {
-    err = ctx->last_code;
+    err = last_code(ctx);
   } else {
     /* a stage's walls are added by its setup */
     for (int i = 0; i < stage + (setup != 0) && i < w.sc.nstage; ++i) walls_before += w.sc.stages[i].nwalls;
@@ -951,7 +980,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     set_threads(&w);
     mpmc_sim_set_threads(w.sim, w.sc.threads);
     sim = NULL;
-    if (wf_metrics_init(w.sim, &w.sc)) err = ctx->last_code;
+    if (wf_metrics_init(w.sim, &w.sc)) err = last_code(ctx);
     say(&w, "resuming %s at stage %d/%d (%s), %.4g s into it", scene, stage + 1, w.sc.nstage,
         w.sc.stages[stage].name, clock.t_stage);
     if (!err) {
@@ -960,7 +989,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
       if (wf_series_trim(series, &w.sc, steps, &w.series_rows, msg, sizeof msg))
         err = fail(&w, MPMC_ERR_IO, "resume: %s", msg);
     }
-    if (!err) err = open_outputs(&w, 1) ? ctx->last_code : 0;
+    if (!err) err = open_outputs(&w, 1) ? last_code(ctx) : 0;
     if (!err) {
       if (setup && w.sc.stages[stage].has_gravity) mpmc_sim_set_gravity(w.sim, w.sc.stages[stage].gravity);
       if (setup) {
@@ -968,7 +997,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
         mpmc_sim_set_damping(w.sim, s->damping);
         mpmc_sim_set_flip_blend(w.sim, s->flip);
       }
-      err = run_all(&w, stage, &clock, steps, setup) ? ctx->last_code : 0;
+      err = run_all(&w, stage, &clock, steps, setup) ? last_code(ctx) : 0;
     }
   }
   mpmc_sim_destroy(&sim);

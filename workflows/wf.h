@@ -14,6 +14,8 @@
 #include <stdio.h>
 
 #include "mpmc.h"
+#include "mpmc_gmsh.h"
+#include "mpmc_workflow.h"
 
 #define WF_NAME 64
 #define WF_PATH 4096

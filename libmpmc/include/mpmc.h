@@ -1,5 +1,6 @@
 /* libmpmc: explicit material point method with the assumed deformation gradient (F-bar)
- * of Zhao, Jiang & Choo (2023).  The only public header.
+ * of Zhao, Jiang & Choo (2023).  The core's public header; the optional libraries declare
+ * theirs beside it (mpmc_gmsh.h: libmpmc_gmsh, mpmc_workflow.h: libmpmc_workflow).
  *
  * Conventions: every function returns an int error code, 0 (MPMC_SUCCESS) on success;
  * the context records a human-readable message for the last failure
@@ -159,6 +160,11 @@ int mpmc_context_destroy(mpmc_context *ctx);
 const char *mpmc_context_last_error(const mpmc_context ctx);
 int mpmc_context_get_last_error(const mpmc_context ctx, char *buf, int len);
 int mpmc_context_clear_error(mpmc_context ctx);
+int mpmc_context_get_last_code(const mpmc_context ctx, int *code);
+/* Record an error as the library does ("message [file:line]"); returns code.  For the
+ * libraries and callbacks built on libmpmc. */
+int mpmc_context_set_error(mpmc_context ctx, int code, const char *file, int line,
+                           const char *message);
 int mpmc_context_set_log_level(mpmc_context ctx, int level);
 int mpmc_version(int *major, int *minor, int *patch);
 
@@ -384,19 +390,6 @@ int mpmc_sim_seed_box(mpmc_sim sim, const double *lo, const double *hi, int ppc,
 int mpmc_sim_seed_polygon(mpmc_sim sim, int nvert, const double *xy, int ppc, int material,
                           int *first, int *count);
 
-/* ---- seeding from gmsh (seed_gmsh.c, in the separate library libmpmc_gmsh) ---------- */
-typedef enum {
-  MPMC_SEED_LATTICE = 0,   /* ppc points per cell per axis on the grid, kept inside the mesh */
-  MPMC_SEED_QUADRATURE = 1 /* points at the elements' quadrature points (ppc = order)        */
-} mpmc_seed_mode;
-/* Mesh a .geo (or read a .msh) and add points for the physical group `region` (surface in
- * 2D, volume in 3D).  Points near the boundary physical groups (curves in 2D, surfaces in
- * 3D) and physical point groups become particle sets named after the groups, and node sets
- * of the grid nodes near them (for walls: mpmc_sim_add_wall_nodes).  On failure nothing is
- * added. */
-int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
-                   int material, int *first, int *count);
-
 /* ---- output: HDF5 snapshots + XDMF (io_hdf5.c, io_xdmf.c) ------------------------ */
 typedef struct mpmc_output_s *mpmc_output;
 /* Create (truncate) h5path and write xdmfpath next to it on every snapshot. */
@@ -462,23 +455,6 @@ typedef int (*mpmc_yield_fn)(void *data, const double *tau, double alpha, mpmc_y
 int mpmc_sim_add_material_user_yield(mpmc_sim sim, mpmc_yield_fn fn, void *data, double E,
                                      double nu, double rho, int *id);
 int mpmc_sim_set_material_yield_fn(mpmc_sim sim, int material, mpmc_yield_fn fn, void *data);
-
-/* ---- the staged workflow (workflows/, library libmpmc_workflow) ---------------------- */
-/* Run a YAML scene: the same as `mpmc run scene --out outdir --set ...`.  overrides are
- * noverride "key.path=value" strings; flags: bit 0 = force (write over outdir).  The
- * summary's figures are then in outdir/summary.json. */
-int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, int noverride,
-                      const char *const *overrides, int flags);
-#define MPMC_WORKFLOW_FORCE 1 /* write into an existing, non-empty outdir              */
-#define MPMC_WORKFLOW_QUIET 2 /* no log and no progress display                        */
-#define MPMC_WORKFLOW_CHECK 4 /* validate the scene and print the plan; run nothing     */
-#define MPMC_WORKFLOW_FOS 8   /* stop after the factor_of_safety stage (`mpmc fos`)     */
-/* Continue the run in outdir from its last checkpoint (`mpmc resume`); flags: QUIET.  A
- * finished run's checkpoint goes on once the scene has another stage or a later end for its
- * last one; with overrides (`mpmc resume DIR --set ...`) applied after the run's own. */
-int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags);
-int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride,
-                             const char *const *overrides, int flags);
 
 #ifdef __cplusplus
 }

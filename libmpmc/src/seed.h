@@ -5,6 +5,7 @@
 #define MPMC_SEED_H
 
 #include "mpmc_impl.h"
+#include "mpmc_gmsh.h"
 
 typedef struct {
   int dim, ppc;
