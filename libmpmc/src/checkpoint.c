@@ -64,6 +64,8 @@ static int write_config(hid_t f, const mpmc_sim sim) {
   st |= mpmc_h5_attr_write(g, "flip", H5T_NATIVE_DOUBLE, 1, &sim->flip);
   st |= mpmc_h5_attr_write(g, "gravity", H5T_NATIVE_DOUBLE, 3, sim->gravity);
   st |= mpmc_h5_attr_write(g, "damping", H5T_NATIVE_DOUBLE, 1, &sim->damping);
+  const double kd[2] = {sim->kdamp, sim->kd_ke}; /* kinetic damping: on, E_k of the last step */
+  st |= mpmc_h5_attr_write(g, "kinetic_damping", H5T_NATIVE_DOUBLE, 2, kd);
   st |= mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &sim->time);
   st |= mpmc_h5_attr_write(g, "grid_lo", H5T_NATIVE_DOUBLE, 3, gr->lo);
   st |= mpmc_h5_attr_write(g, "grid_hi", H5T_NATIVE_DOUBLE, 3, gr->hi);
@@ -110,6 +112,9 @@ static int read_config(hid_t f, mpmc_sim sim) {
   int64_t sort[2] = {0, -1}; /* absent in files of before the sort: never sorted */
   if (H5Aexists(g, "sort_interval_last") > 0)
     st |= mpmc_h5_attr_read(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
+  double kd[2] = {0.0, -1.0}; /* absent in files of before kinetic damping: off */
+  if (H5Aexists(g, "kinetic_damping") > 0)
+    st |= mpmc_h5_attr_read(g, "kinetic_damping", H5T_NATIVE_DOUBLE, 2, kd);
   int axes[2] = {-1, 0}; /* absent in files of before: no sort for an axis change until the next */
   if (H5Aexists(g, "sort_axis_slab_axis") > 0)
     st |= mpmc_h5_attr_read(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
@@ -125,6 +130,8 @@ static int read_config(hid_t f, mpmc_sim sim) {
   MPMC_CALL(mpmc_sim_set_flip_blend(sim, flip));
   MPMC_CALL(mpmc_sim_set_gravity(sim, grav));
   MPMC_CALL(mpmc_sim_set_damping(sim, damp));
+  MPMC_CALL(mpmc_sim_set_kinetic_damping(sim, kd[0] != 0.0));
+  sim->kd_ke = kd[1]; /* the peak test of the next step goes on as without the restart */
   MPMC_CALL(mpmc_sim_set_time(sim, time));
   MPMC_CALL(mpmc_sim_set_grid(sim, lo, hi, h));
   for (int a = 0; a < sim->dim; ++a)
@@ -296,7 +303,7 @@ static const pfield pfields[] = {PF(x, 0, 1),     PF(x0, 0, 1),     PF(v, 0, 1),
                                  PF(stress, 6, 1), PF(Jbar, 1, 0),  PF(be, 6, 0),
                                  PF(eps_p, 1, 0), PF(lp, 1, 0),     PF(force, 0, 0),
                                  PF(cforce, 0, 0), PF(ustate, -1, 0), PF(Janc, 1, 0),
-                                 PF(region, 1, 0)};
+                                 PF(region, 1, 0), PF(Jp, 1, 0)};
 #undef PF
 
 static double **pfield_ptr(mpmc_particles *p, const pfield *f) {

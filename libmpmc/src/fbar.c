@@ -27,6 +27,12 @@
  * Called on its own (tests) the projection scatters here and gathers, both at x,
  * recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter leaves
  * Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
+ * Dilatant plastic flow (the frictional models with psi > 0) changes a point's volume with
+ * no elastic volume change; projecting it with the rest made a plastic dilation at one point
+ * compress the elastic volume of its neighbours and a dilating shear band fed itself until
+ * the run blew up.  Where such models exist (p->Jp), each point scatters j / Jp, Jp its
+ * plastic volume ratio J / J_e (material_frictional.c), and takes Jp x Pi: the projection
+ * smooths the volume change that is not plastic, and a point's plastic dilation stays its own.
  * Touches nothing but dF (handed to the material), Jbar, the grid's fb and fbj and the
  * records' MPMC_VSLOT. */
 #include <math.h>
@@ -49,7 +55,7 @@ MPMC_ALWAYS_INLINE mpmc_v2d scatter_values(mpmc_sim sim, const int DIM, int q) {
   /* no step to measure the travel: the anchored form re-anchors fully (Algorithm 1's) */
   const double j = mpmc_fbar_j(sim->fbar == MPMC_FBAR_ANCHORED, sim->fbar, p, q, dJ, jd, INFINITY);
   p->Jbar[q] = jd;
-  return (mpmc_v2d){Vn, Vn * j};
+  return (mpmc_v2d){Vn, p->Jp ? Vn * j / p->Jp[q] : Vn * j};
 }
 
 /* Scatter point q: V^n and V^n j onto its nodes (Algorithm 1, step 3), where P2G and G2P
@@ -122,6 +128,7 @@ static inline double cbrt_near1(double r) {
  * gather, the division runs beside it instead of after it); keeps pi as Jbar. */
 MPMC_ALWAYS_INLINE double projection_scale(mpmc_particles *p, const int DIM, int q, double pi,
                                            double inv) {
+  if (p->Jp) pi *= p->Jp[q]; /* the point's own plastic dilation on top of the projection */
   const double r = pi * inv;
   p->Jbar[q] = pi;
   return DIM == 2 ? sqrt(r) : cbrt_near1(r);
@@ -198,7 +205,8 @@ MPMC_ALWAYS_INLINE void gather_pi4(const mpmc_grid *g, const int DIM, const int 
 MPMC_ALWAYS_INLINE void gather_finish4(mpmc_particles *p, const int DIM, int q,
                                        const mpmc_b4d *pip, const mpmc_b4d *invp,
                                        double *scale) {
-  const mpmc_b4d pi = *pip;
+  mpmc_b4d pi = *pip;
+  if (p->Jp) pi *= *(const mpmc_b4du *)(p->Jp + q); /* as projection_scale */
   *(mpmc_b4du *)(p->Jbar + q) = pi;
   const mpmc_b4d r = pi * *invp, e = r - 1.0;
   const mpmc_b4l magn = {INT64_MAX, INT64_MAX, INT64_MAX, INT64_MAX}; /* all but the sign */

@@ -161,6 +161,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     const double Vn = p->vol0[q] * Jn;
     const double jd = p->Jbar[q] * dJ; /* kept for the gather (fbar.c) */
     vv = (mpmc_v2d){Vn, Vn * mpmc_fbar_j(FB & 4, sim->fbar, p, q, dJ, jd, travel)};
+    if (p->Jp) vv[1] /= p->Jp[q]; /* the volume change that is not plastic (fbar.c) */
     p->Jbar[q] = jd;
   }
   const double vj = vv[1];

@@ -84,6 +84,9 @@ int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int
         if (q < first_bad) first_bad = q; /* its state is left as it was */
         continue;
       }
+      /* the plastic volume ratio: J_e,trial / J_e,new = det(dF) sqrt(det b_e^n) / J_e,new */
+      if (p->Jp && info.plastic)
+        p->Jp[q] *= mpmc_det3(F) * sqrt(mpmc_det_sym(beq)) / Je;
       for (int k = 0; k < 6; ++k) beq[k] = be[k];
       p->eps_p[q] = ep;
       p->region[q] = info.region;

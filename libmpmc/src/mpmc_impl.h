@@ -69,6 +69,10 @@ typedef struct {
   double *be;    /* [n][6] elastic left Cauchy-Green (solid materials)            */
   double *eps_p; /* [n] equivalent plastic strain (plastic materials)             */
   double *region;/* [n] where the last return went (frictional models, MPMC_MC_*)  */
+  double *Jp;    /* [n] plastic volume ratio J / J_e of dilatant flow (frictional
+                    models with F-bar on): F-bar projects J / Jp, the volume change
+                    that is not plastic, and hands the material Jp x the projection,
+                    so that plastic dilation stays at its point (fbar.c)           */
   double *lp;    /* [n] uGIMP half-length, fixed at its initial value (uGIMP)      */
   double *force; /* [n][dim] external force (tractions)                           */
   double *cforce;/* [n][dim] contact force from rigid bodies (contact_barrier.c)   */
@@ -366,6 +370,8 @@ struct mpmc_sim_s {
   double flip;        /* FLIP/PIC blend eta (eq 13)                                    */
   double gravity[3];
   double damping;     /* local damping alpha                                           */
+  int kdamp;          /* kinetic damping on (damping.c, mpmc_kinetic_damping)           */
+  double kd_ke;       /* kinetic damping: E_k of the points after the last step; -1: none */
   int solver;
   int nthreads;
   int force_dt;
@@ -509,6 +515,8 @@ int mpmc_sort_due(struct mpmc_sim_s *sim);
 int mpmc_sim_prepare(struct mpmc_sim_s *sim);
 int mpmc_boundary_apply_flags(struct mpmc_sim_s *sim);
 void mpmc_damping_apply(double alpha, double *restrict f, const double *restrict v, int dim);
+/* Kinetic damping after G2P: at a peak of the points' E_k, every point velocity to zero. */
+void mpmc_kinetic_damping(struct mpmc_sim_s *sim);
 double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor);
 void mpmc_return_map_free(struct mpmc_sim_s *sim);
 /* contact_barrier.c: fill p->cforce before P2G (only called when sim->bodies is set), the

@@ -240,6 +240,20 @@ int mpmc_sim_set_damping(mpmc_sim sim, double alpha) {
   return MPMC_SUCCESS;
 }
 
+/**
+ * @brief Kinetic damping (Cundall's dynamic relaxation) for quasi-static stages: the points'
+ *        kinetic energy is tracked every step and every point velocity set to zero when it
+ *        has passed a peak.  Combines with local damping (mpmc_sim_set_damping).
+ * @param on 1: on, 0: off; either call restarts the tracking (from the next step's energy)
+ */
+int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(on == 0 || on == 1, sim->ctx, MPMC_ERR_ARG, "kinetic damping on = %d must be 0 or 1", on);
+  sim->kdamp = on;
+  sim->kd_ke = -1.0;
+  return MPMC_SUCCESS;
+}
+
 /** @brief Local solver for plastic return mapping (mpmc_solver). */
 int mpmc_sim_set_solver(mpmc_sim sim, int solver) {
   if (!sim) return MPMC_ERR_ARG;
@@ -352,6 +366,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
       for (int k = 0; k < 6; ++k) p->be[q * 6 + k] = k < 3 ? 1.0 : 0.0;
     if (p->eps_p) p->eps_p[q] = 0.0;
     if (p->region) p->region[q] = 0.0;
+    if (p->Jp) p->Jp[q] = 1.0;
     if (p->lp) p->lp[q] = 0.5 * pow(volume[i], 1.0 / d);
     if (p->force)
       for (int a = 0; a < d; ++a) p->force[q * d + a] = 0.0;
@@ -394,6 +409,8 @@ int mpmc_sim_prepare(mpmc_sim sim) {
   }
   if (plastic) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->eps_p, 1, 0.0));
   if (region) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->region, 1, 0.0));
+  /* the plastic volume ratio: with F-bar and a frictional (dilatant) model only */
+  if (region && sim->fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jp, 1, 1.0));
   if (sim->fbar && !p->Jbar) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
     for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
