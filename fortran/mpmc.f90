@@ -161,7 +161,8 @@ module mpmc
   public :: mpmc_sim_create, mpmc_sim_destroy, mpmc_sim_get_context, mpmc_sim_get_dim, &
     mpmc_sim_set_grid, mpmc_sim_get_grid, mpmc_sim_set_basis, mpmc_sim_set_fbar, &
     mpmc_sim_get_fbar, mpmc_sim_set_flip_blend, mpmc_sim_set_gravity, mpmc_sim_set_damping, &
-    mpmc_sim_set_solver, mpmc_sim_set_threads, mpmc_sim_set_kernels, mpmc_sim_get_kernels
+    mpmc_sim_set_kinetic_damping, mpmc_sim_set_solver, mpmc_sim_set_threads, &
+    mpmc_sim_set_kernels, mpmc_sim_get_kernels
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
@@ -348,6 +349,13 @@ module mpmc
       import :: c_int, c_double, mpmc_sim
       type(mpmc_sim), value :: sim
       real(c_double), value :: alpha
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_kinetic_damping(sim, on) bind(C, name='mpmc_sim_set_kinetic_damping') &
+        result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: on
       integer(c_int) :: ierr
     end function
     function mpmc_sim_set_solver(sim, solver) bind(C, name='mpmc_sim_set_solver') result(ierr)

@@ -359,6 +359,7 @@ static void log_plan(const wf_run *w) {
       snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", strength = material's / %g",
                s->strength_reduction);
     if (s->damping > 0) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", damping %g", s->damping);
+    if (s->kinetic_damping) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", kinetic damping");
     if (s->nwalls) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", +%d walls", s->nwalls);
     if (s->nremove) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", -%d walls", s->nremove);
     say(w, "stage %d/%d %s: %s%s", i + 1, sc->nstage, s->name, end, extra);
@@ -372,6 +373,7 @@ static int stage_setup(wf_run *w, int i) {
   mpmc_sim sim = w->sim;
   if (s->has_gravity) WF_TRY(w, mpmc_sim_set_gravity(sim, s->gravity), "stages.%d.gravity", i);
   WF_TRY(w, mpmc_sim_set_damping(sim, s->damping), "stages.%d.damping", i);
+  WF_TRY(w, mpmc_sim_set_kinetic_damping(sim, s->kinetic_damping), "stages.%d.kinetic_damping", i);
   WF_TRY(w, mpmc_sim_set_flip_blend(sim, s->flip), "stages.%d.flip", i);
   WF_TRY(w, mpmc_sim_set_force_dt(sim, s->force_dt), "stages.%d.force_dt", i);
   int base = 0;
@@ -995,6 +997,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
       if (setup) {
         const wf_stage *s = &w.sc.stages[stage];
         mpmc_sim_set_damping(w.sim, s->damping);
+        mpmc_sim_set_kinetic_damping(w.sim, s->kinetic_damping);
         mpmc_sim_set_flip_blend(w.sim, s->flip);
       }
       err = run_all(&w, stage, &clock, steps, setup) ? last_code(ctx) : 0;

@@ -973,7 +973,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   sc->nstage = ss->n;
   sc->stages = calloc((size_t)ss->n, sizeof *sc->stages);
   if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
-  static const char *const keys[] = {"name", "gravity", "damping", "flip", "walls", "remove_walls", "tractions",
+  static const char *const keys[] = {"name", "gravity", "damping", "kinetic_damping", "flip", "walls", "remove_walls", "tractions",
                                      "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
                                      "snapshots", "series_points", "rigid_bodies", "force_dt",
                                      "factor_of_safety", NULL};
@@ -995,6 +995,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     }
     const range damp = {0, 1, 0, 1};
     if (get_num(r, n, p, "damping", 0, 0, damp, &s->damping)) return -1;
+    if (get_bool(r, n, p, "kinetic_damping", 0, &s->kinetic_damping)) return -1;
     /* absent: the scene's blend (a quasi-static stage of a FLIP scene takes a little PIC:
      * docs/theory.md) */
     if (get_num(r, n, p, "flip", 0, sc->flip, UNIT, &s->flip)) return -1;

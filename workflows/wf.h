@@ -117,6 +117,7 @@ typedef struct {
   int has_gravity;
   double gravity[3];
   double damping;
+  int kinetic_damping; /* velocities to zero at each peak of E_k (mpmc_sim_set_kinetic_damping) */
   double flip; /* the stage's FLIP/PIC blend (the scene's where the stage sets none) */
   int nwalls;
   wf_wall *walls;

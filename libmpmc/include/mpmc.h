@@ -184,6 +184,7 @@ int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled);
 int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
 int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
+int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on); /* 0 off, 1 on */
 int mpmc_sim_set_solver(mpmc_sim sim, int solver);
 int mpmc_sim_set_threads(mpmc_sim sim, int nthreads);
 int mpmc_sim_set_kernels(mpmc_sim sim, int kernels);      /* mpmc_kernels */
