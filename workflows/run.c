@@ -312,20 +312,6 @@ static void log_plan(const wf_run *w) {
 #endif
 #undef FEATURE
   say(w, "enabled: %s", on[0] ? on : "nothing optional");
-  /* a known limit (docs/materials.md): F-bar with dilatant plastic flow has grown without
-   * bound in the footing (strip_footing_cphi.yaml with psi = phi) */
-  for (int i = 0; sc->fbar && i < sc->nmat; ++i) {
-    const wf_material *m = &sc->mats[i];
-    mpmc_model_info mi;
-    if (mpmc_model_get_info(m->model, &mi)) continue;
-    for (int k = 0; k < mi.nstore; ++k) {
-      mpmc_param_info pi;
-      if (mpmc_model_get_param(m->model, k, &pi) || strcmp(pi.name, "psi") || !(m->par[k] > 0)) continue;
-      say(w, "warning: material %s: dilatant flow (psi = %g deg) with F-bar has run unstable in our "
-             "tests (docs/materials.md, known limits); psi = 0 or fbar: false are safe",
-          m->name, m->par[k]);
-    }
-  }
   say(w, "left out: %s", off[0] ? off : "nothing");
   int kern = MPMC_KERNELS_BASELINE;
   if (w->sim) mpmc_sim_get_kernels(w->sim, &kern);
