@@ -53,7 +53,8 @@ module mpmc
   integer(c_int), parameter, public :: MPMC_FIELD_POSITION = 0, MPMC_FIELD_VELOCITY = 1, &
     MPMC_FIELD_MASS = 2, MPMC_FIELD_VOLUME0 = 3, MPMC_FIELD_J = 4, MPMC_FIELD_JBAR = 5, &
     MPMC_FIELD_STRESS = 6, MPMC_FIELD_BE = 7, MPMC_FIELD_EPS_P = 8, MPMC_FIELD_FORCE = 9, &
-    MPMC_FIELD_X0 = 10, MPMC_FIELD_REGION = 11, MPMC_FIELD_COUNT = 12
+    MPMC_FIELD_X0 = 10, MPMC_FIELD_REGION = 11, MPMC_FIELD_PORE_PRESSURE = 12, &
+    MPMC_FIELD_COUNT = 13
   ! phases of a step: stats%phase_seconds(MPMC_PHASE_P2G) (indexed from 0, as in C)
   integer(c_int), parameter, public :: MPMC_PHASE_SORT = 0, MPMC_PHASE_SLABS = 1, &
     MPMC_PHASE_P2G = 2, MPMC_PHASE_GRID = 3, MPMC_PHASE_G2P = 4, MPMC_PHASE_FBAR = 5, &
@@ -162,7 +163,8 @@ module mpmc
     mpmc_sim_set_grid, mpmc_sim_get_grid, mpmc_sim_set_basis, mpmc_sim_set_fbar, &
     mpmc_sim_get_fbar, mpmc_sim_set_flip_blend, mpmc_sim_set_gravity, mpmc_sim_set_damping, &
     mpmc_sim_set_kinetic_damping, mpmc_sim_set_solver, mpmc_sim_set_threads, &
-    mpmc_sim_set_kernels, mpmc_sim_get_kernels
+    mpmc_sim_set_kernels, mpmc_sim_get_kernels, mpmc_sim_set_water_table, &
+    mpmc_sim_set_water_table_plane
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
@@ -356,6 +358,23 @@ module mpmc
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
       integer(c_int), value :: on
+      integer(c_int) :: ierr
+    end function
+    ! xh(2, n): (x, h) of the piezometric line, x increasing; n = 0 removes the table
+    function mpmc_sim_set_water_table(sim, n, xh, gamma_w) &
+        bind(C, name='mpmc_sim_set_water_table') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: n
+      real(c_double), intent(in) :: xh(*)
+      real(c_double), value :: gamma_w
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_water_table_plane(sim, a, b, c, gamma_w) &
+        bind(C, name='mpmc_sim_set_water_table_plane') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), value :: a, b, c, gamma_w
       integer(c_int) :: ierr
     end function
     function mpmc_sim_set_solver(sim, solver) bind(C, name='mpmc_sim_set_solver') result(ierr)

@@ -176,6 +176,19 @@ static void test_bad_override(void **state) {
   e = run_lib(scene, DIR "/out-override", 1, srt, 0, msg, sizeof msg);
   if (e == 0) fail_msg("--set sort_interval=-1: expected a failure, got 0");
   test_expect_in("--set sort_interval", msg, "key 'sort_interval': must be in [0, 1e+09] (got -1)");
+  /* water tables: x must increase; a plane is 3D only; a line runs */
+  const char *wback[] = {"water_table={points: [[1, 1], [0, 0]]}"};
+  e = run_lib(scene, DIR "/out-override", 1, wback, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set water_table with x decreasing: expected a failure, got 0");
+  test_expect_in("--set water_table", msg,
+                 "key 'water_table.points.1': x = 0 must exceed the previous point's x = 1");
+  const char *wplane[] = {"water_table={plane: [1, 0, 0]}"};
+  e = run_lib(scene, DIR "/out-override", 1, wplane, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set water_table plane in 2D: expected a failure, got 0");
+  test_expect_in("--set water_table plane", msg, "key 'water_table.plane': a plane is for 3D scenes");
+  const char *wok[] = {"water_table={points: [[0, 0.5], [2, 0.5]]}", "stages.0.end.time=0.0005"};
+  e = run_lib(scene, DIR "/out-water", 2, wok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e != 0) fail_msg("--set water_table points: expected success, got %d: %s", e, msg);
   /* an empty list of snapshot plots is none, not an error; sorting every step runs */
   const char *none[] = {"snapshot_plots=[]", "sort_interval=1", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-noplots", 3, none, MPMC_WORKFLOW_FORCE, msg, sizeof msg);

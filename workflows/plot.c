@@ -49,6 +49,9 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
   /* the return region of the frictional models (docs/materials.md), last column */
   double *region = NULL;
   if (mpmc_sim_get_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
+  /* the water table's pore pressure, after it */
+  double *pw = NULL;
+  if ((!sc->water.n && !sc->water.has_plane) || mpmc_sim_get_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
   const int d = sc->dim;
   depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
   FILE *f = fopen(path, "w");
@@ -63,8 +66,8 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
     order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
   }
   if (d == 3) qsort(order, (size_t)np, sizeof *order, by_depth);
-  fprintf(f, "%s%s\n", d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz" : "x,y,mean_stress,eps_p,ux,uy",
-          region ? ",region" : "");
+  fprintf(f, "%s%s%s\n", d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz" : "x,y,mean_stress,eps_p,ux,uy",
+          region ? ",region" : "", pw ? ",pore_pressure" : "");
   for (int k = 0; k < np; ++k) {
     const size_t q = (size_t)order[k].q;
     const double p = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3.0;
@@ -72,6 +75,7 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
     fprintf(f, "%.7g,%.7g", p, eps ? eps[q] : 0.0);
     for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - x0[q * d + a]);
     if (region) fprintf(f, ",%d", (int)region[q]);
+    if (pw) fprintf(f, ",%.7g", pw[q]);
     fputc('\n', f);
   }
   free(order);
@@ -161,19 +165,28 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
   /* columns of final_state.csv: coordinates, mean stress, eps_p */
   const int cx = hx + 1, cy = vy + 1, cp = d + 1, ce = d + 2;
   wf_gnuplot_terminal(g, 1400, 700, 12);
+  /* the phreatic line over the grid's width, where the view is along x (a polyline table) */
+  const char *water = "";
+  if (sc->water.n && hx == 0) {
+    const wf_water *wt = &sc->water;
+    fprintf(g, "$water << EOD\n%.9g,%.9g\n", sc->lo[0], wt->xh[1]);
+    for (int k = 0; k < wt->n; ++k) fprintf(g, "%.9g,%.9g\n", wt->xh[2 * k], wt->xh[2 * k + 1]);
+    fprintf(g, "%.9g,%.9g\nEOD\n", sc->hi[0], wt->xh[2 * wt->n - 1]);
+    water = ", $water using 1:2 with lines lw 2 lc rgb '#1f78b4' title 'water table'";
+  }
   fprintf(g, "set size ratio -1\nset xlabel '%c [m]'\nset ylabel '%c [m]'\nset grid\n", ax[hx], ax[vy]);
   fprintf(g, "set output 'final_mean_stress.png'\n");
   fprintf(g, "set title '%s%s: mean stress p = tr(sigma)/3 [kPa] at t = %.3f s (tension > 0)' noenhanced\n", sc->name,
           d == 3 ? " (side view)" : "", t);
   fprintf(g, "set cblabel 'p [kPa]'\n");
-  fprintf(g, "plot 'final_state.csv' skip 1 using %d:%d:($%d/1000) with points pt 7 ps 0.35 lc palette notitle\n",
-          cx, cy, cp);
+  fprintf(g, "plot 'final_state.csv' skip 1 using %d:%d:($%d/1000) with points pt 7 ps 0.35 lc palette notitle%s\n",
+          cx, cy, cp, water);
   if (has_eps) {
     fprintf(g, "set output 'final_eps_p.png'\n");
     fprintf(g, "set title '%s%s: equivalent plastic strain at t = %.3f s' noenhanced\nset cblabel 'eps_p' noenhanced\nset cbrange [0:*]\n",
             sc->name, d == 3 ? " (side view)" : "", t);
-    fprintf(g, "plot 'final_state.csv' skip 1 using %d:%d:%d with points pt 7 ps 0.35 lc palette notitle\n", cx, cy,
-            ce);
+    fprintf(g, "plot 'final_state.csv' skip 1 using %d:%d:%d with points pt 7 ps 0.35 lc palette notitle%s\n", cx, cy,
+            ce, water);
     fprintf(g, "set cbrange [*:*]\n");
   }
   /* time series: kinetic energy and the scene's metrics */

@@ -233,6 +233,13 @@ static int build(wf_run *w) {
     const int e = mpmc_sim_add_material(sim, wf_model_name(m->model), m->par, m->npar, &m->id);
     WF_TRY(w, e, "materials.%s", m->name);
   }
+  /* before the seeding: points below the table weigh their saturated density */
+  if (sc->water.has_plane)
+    WF_TRY(w, mpmc_sim_set_water_table_plane(sim, sc->water.plane[0], sc->water.plane[1], sc->water.plane[2],
+                                             sc->water.gamma_w),
+           "water_table");
+  else if (sc->water.n)
+    WF_TRY(w, mpmc_sim_set_water_table(sim, sc->water.n, sc->water.xh, sc->water.gamma_w), "water_table");
   for (int i = 0; i < sc->nbody; ++i) {
     const wf_body *b = &sc->bodies[i];
     const int mat = sc->mats[b->material].id;
@@ -298,6 +305,7 @@ static void log_plan(const wf_run *w) {
   } while (0)
   FEATURE(sc->fbar, "F-bar");
   FEATURE(plastic, "plastic state (eps_p)");
+  FEATURE(sc->water.n || sc->water.has_plane, "water table (pore pressure)");
   FEATURE(gmsh, "gmsh seeding");
   FEATURE(damping, "local damping");
   FEATURE(walls > 0, "walls");

@@ -482,6 +482,31 @@ static int get_vec(rd *r, const wf_node *map, const char *path, const char *key,
   return 0;
 }
 
+/* A list of at least `min` points [x, y] under key (required) into a new array *xy of *n pairs. */
+static int get_points(rd *r, const wf_node *map, const char *path, const char *key, int min, double **xy,
+                      int *n) {
+  char full[512];
+  join(full, sizeof full, path, key);
+  const wf_node *v = map_get(map, key);
+  if (!v) return fail_at(r, map, full, "required key is missing");
+  if (v->kind != WF_SEQ || v->n < min)
+    return fail_at(r, v, full, "expected a list of at least %d [x, y] point%s", min, min == 1 ? "" : "s");
+  *xy = malloc(sizeof(double) * 2 * (size_t)v->n);
+  if (!*xy) return fail_at(r, v, full, "out of memory");
+  *n = v->n;
+  for (int k = 0; k < v->n; ++k) {
+    char item[560];
+    snprintf(item, sizeof item, "%s.%d", full, k);
+    const wf_node *p = v->items[k];
+    double *q = *xy + 2 * k;
+    if (!p || p->kind != WF_SEQ || p->n != 2 || parse_number(p->items[0], &q[0]) || parse_number(p->items[1], &q[1]))
+      return fail_at(r, p, item, "expected a point [x, y] (got %s)", shown(p));
+    if (!isfinite(q[0]) || !isfinite(q[1]))
+      return fail_at(r, p, item, "expected finite coordinates (got [%g, %g])", q[0], q[1]);
+  }
+  return 0;
+}
+
 /* ---- --set overrides ------------------------------------------------------------------- */
 static int apply_override(wf_node *root, const char *arg, const char *origin, char *msg, size_t len) {
   const char *eq = strchr(arg, '=');
@@ -751,27 +776,8 @@ static int read_geometry(rd *r, const wf_node *root, wf_scene *sc) {
         }
     } else if (b->type == WF_GEOM_POLYGON) {
       join(full, sizeof full, path, "vertices");
-      const wf_node *v = map_get(g, "vertices");
       if (sc->dim != 2) return fail_at(r, map_get(g, "type"), full, "polygons are 2D only (dim = %d)", sc->dim);
-      if (!v) return fail_at(r, g, full, "required key is missing");
-      if (v->kind != WF_SEQ || v->n < 3)
-        return fail_at(r, v, full, "expected a list of at least 3 [x, y] points");
-      b->nvert = v->n;
-      b->xy = malloc(sizeof(double) * 2 * (size_t)v->n);
-      if (!b->xy) return fail_at(r, v, full, "out of memory");
-      for (int k = 0; k < v->n; ++k) {
-        char item[560];
-        snprintf(item, sizeof item, "%s.%d", full, k);
-        const wf_node *p = v->items[k];
-        double xy[2];
-        if (!p || p->kind != WF_SEQ || p->n != 2 || parse_number(p->items[0], &xy[0]) ||
-            parse_number(p->items[1], &xy[1]))
-          return fail_at(r, p, item, "expected a point [x, y] (got %s)", shown(p));
-        if (!isfinite(xy[0]) || !isfinite(xy[1]))
-          return fail_at(r, p, item, "expected finite coordinates (got [%g, %g])", xy[0], xy[1]);
-        b->xy[2 * k] = xy[0];
-        b->xy[2 * k + 1] = xy[1];
-      }
+      if (get_points(r, g, path, "vertices", 3, &b->xy, &b->nvert)) return -1;
     } else {
       char file[WF_PATH];
       join(full, sizeof full, path, "file");
@@ -888,21 +894,8 @@ static int read_rigid(rd *r, const wf_node *root, wf_scene *sc) {
       continue;
     }
     join(full, sizeof full, path, "vertices");
-    const wf_node *v = map_get(g, "vertices");
     if (sc->dim != 2) return fail_at(r, map_get(g, "type"), full, "rigid polygons are 2D only (dim = %d)", sc->dim);
-    if (!v) return fail_at(r, g, full, "required key is missing");
-    if (v->kind != WF_SEQ || v->n < 3) return fail_at(r, v, full, "expected a list of at least 3 [x, y] points");
-    b->nvert = v->n;
-    b->xy = malloc(sizeof(double) * 2 * (size_t)v->n);
-    if (!b->xy) return fail_at(r, v, full, "out of memory");
-    for (int k = 0; k < v->n; ++k) {
-      char item[560];
-      snprintf(item, sizeof item, "%s.%d", full, k);
-      const wf_node *p = v->items[k];
-      if (!p || p->kind != WF_SEQ || p->n != 2 || parse_number(p->items[0], &b->xy[2 * k]) ||
-          parse_number(p->items[1], &b->xy[2 * k + 1]))
-        return fail_at(r, p, item, "expected a point [x, y] (got %s)", shown(p));
-    }
+    if (get_points(r, g, path, "vertices", 3, &b->xy, &b->nvert)) return -1;
   }
   return 0;
 }
@@ -1197,6 +1190,35 @@ static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
   return 0;
 }
 
+/* water_table: {points: [[x, h], ...] | plane: [a, b, c], unit_weight: gamma_w} */
+static int read_water(rd *r, const wf_node *root, wf_scene *sc) {
+  const wf_node *w = map_get(root, "water_table");
+  if (!w) return 0;
+  static const char *const keys[] = {"points", "plane", "unit_weight", NULL};
+  if (check_map(r, w, "water_table", keys)) return -1;
+  wf_water *wt = &sc->water;
+  const wf_node *pts = map_get(w, "points"), *pl = map_get(w, "plane");
+  if (!pts == !pl)
+    return fail_at(r, w, "water_table", "give the piezometric line as points: [[x, h], ...] or (3D) "
+                   "plane: [a, b, c] for h = a + b x + c y, one of the two");
+  if (pts) {
+    if (get_points(r, w, "water_table", "points", 1, &wt->xh, &wt->n)) return -1;
+    for (int k = 1; k < wt->n; ++k)
+      if (wt->xh[2 * k] <= wt->xh[2 * (k - 1)]) {
+        char item[96];
+        snprintf(item, sizeof item, "water_table.points.%d", k);
+        return fail_at(r, pts->items[k], item, "x = %g must exceed the previous point's x = %g",
+                       wt->xh[2 * k], wt->xh[2 * (k - 1)]);
+      }
+  } else {
+    if (sc->dim != 3)
+      return fail_at(r, pl, "water_table.plane", "a plane is for 3D scenes: in 2D give points: [[x, h], ...]");
+    if (get_vec(r, w, "water_table", "plane", 1, 3, ANY, wt->plane)) return -1;
+    wt->has_plane = 1;
+  }
+  return get_num(r, w, "water_table", "unit_weight", 0, 9810.0, POS, &wt->gamma_w);
+}
+
 static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
   const wf_node *m = map_get(root, "metrics");
   if (!m) return 0;
@@ -1244,7 +1266,7 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   static const char *const keys[] = {"scene", "description", "dim", "geometry", "grid", "basis", "fbar",
                                      "flip", "solver", "threads", "materials", "stages", "metrics",
                                      "plots", "checkpoint_interval", "progress_interval", "rigid_bodies",
-                                     "contact", "snapshot_plots", "sort_interval", NULL};
+                                     "contact", "snapshot_plots", "sort_interval", "water_table", NULL};
   if (check_map(r, root, "", keys)) return -1;
   char def[WF_NAME];
   const char *base = strrchr(sc->path, '/');
@@ -1300,7 +1322,7 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   if (get_num(r, root, "", "checkpoint_interval", 0, 300, POS, &sc->checkpoint_interval)) return -1;
   if (get_num(r, root, "", "progress_interval", 0, 5, POS, &sc->progress_interval)) return -1;
   if (read_materials(r, root, sc) || read_geometry(r, root, sc) || read_rigid(r, root, sc) || read_stages(r, root, sc) ||
-      read_metrics(r, root, sc) || read_snapplots(r, root, sc))
+      read_metrics(r, root, sc) || read_snapplots(r, root, sc) || read_water(r, root, sc))
     return -1;
   return 0;
 }
@@ -1386,6 +1408,9 @@ void wf_scene_free(wf_scene *sc) {
   }
   for (int i = 0; i < sc->nsnapplot && sc->snapplots; ++i) free(sc->snapplots[i].times);
   free(sc->snapplots);
+  free(sc->water.xh);
+  sc->water.xh = NULL;
+  sc->water.n = 0;
   sc->snapplots = NULL;
   sc->nsnapplot = 0;
   free(sc->bodies);

@@ -177,6 +177,16 @@ typedef struct {
   double range[2];           /* colour range (default: common min/max of the snapshots)  */
 } wf_snapplot;
 
+/* water_table: the piezometric line (x, h) or, in 3D, plane h = a + b x + c y
+ * (mpmc_sim_set_water_table) */
+typedef struct {
+  int n;                     /* polyline vertices; 0: none (or the plane)            */
+  double *xh;                /* [n][2]                                               */
+  int has_plane;
+  double plane[3];
+  double gamma_w;            /* unit weight of water [N/m^3]                         */
+} wf_water;
+
 typedef struct {
   char path[WF_PATH];        /* the scene file as given                             */
   char dir[WF_PATH];         /* its directory (for relative mesh paths)             */
@@ -199,6 +209,7 @@ typedef struct {
   int nsnapplot;             /* snapshot_plots: PNGs of the state at given times        */
   wf_snapplot *snapplots;
   int plots;                 /* write PNG plots                                     */
+  wf_water water;            /* water_table: hydrostatic pore pressure (water.c)    */
   double checkpoint_interval;/* wall seconds between checkpoints inside a stage     */
   double progress_interval;  /* wall seconds between plain progress lines           */
 } wf_scene;

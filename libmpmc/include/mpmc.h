@@ -122,7 +122,8 @@ typedef enum {
                               Drucker-Prager only): 0 elastic, 1 plane (cone), 2 edge in
                               triaxial compression, 3 in extension, 4 apex, 5 tension
                               cut-off, 6 and 7 its edges and corners (docs/materials.md) */
-  MPMC_FIELD_COUNT = 12
+  MPMC_FIELD_PORE_PRESSURE = 12, /* [1] the water table's pore pressure (with one only) */
+  MPMC_FIELD_COUNT = 13
 } mpmc_field;
 
 /* The phases of a step, as mpmc_stats.phase_seconds counts their wall time. */
@@ -185,6 +186,17 @@ int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
 int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
 int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on); /* 0 off, 1 on */
+/* A water table: hydrostatic pore pressure p = gamma_w max(0, h - z) below the piezometric
+ * elevation h (z: the last coordinate, gravity along -z).  h is a polyline of n vertices
+ * xh = {x0, h0, x1, h1, ...} over x with x increasing (2D; in 3D the same across y), held
+ * constant beyond its ends; n = 0 removes the table.  The models marked effective in the
+ * table (Mohr-Coulomb, Drucker-Prager, user yield surfaces) take their stresses as effective
+ * and carry the total sigma' - p I; the others (Hencky-J2's undrained total stresses) are
+ * unaffected.  The points' masses follow: rho_sat below the table, rho above (points added
+ * later too).  Pore pressure: MPMC_FIELD_PORE_PRESSURE. */
+int mpmc_sim_set_water_table(mpmc_sim sim, int n, const double *xh, double gamma_w);
+/* 3D: the piezometric plane h = a + b x + c y. */
+int mpmc_sim_set_water_table_plane(mpmc_sim sim, double a, double b, double c, double gamma_w);
 int mpmc_sim_set_solver(mpmc_sim sim, int solver);
 int mpmc_sim_set_threads(mpmc_sim sim, int nthreads);
 int mpmc_sim_set_kernels(mpmc_sim sim, int kernels);      /* mpmc_kernels */
@@ -260,8 +272,8 @@ int mpmc_model_count(int *n);
 int mpmc_model_find(const char *name, int *model);
 int mpmc_model_get_info(int model, mpmc_model_info *info);
 int mpmc_model_get_param(int model, int k, mpmc_param_info *info);
-/* Add a material of the named model from its first nstore parameters in the table's order
- * and units (NAN: the default of an optional one). */
+/* Add a material of the named model from its first npar (<= nstore) parameters in the
+ * table's order and units (NAN, or left out at the end: the default of an optional one). */
 int mpmc_sim_add_material(mpmc_sim sim, const char *model, const double *par, int npar, int *id);
 /* A material's model, current (strength-reduced) parameters and reduction factor; par holds
  * MPMC_MAX_PARAMS values (any may be NULL). */

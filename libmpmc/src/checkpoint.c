@@ -82,8 +82,44 @@ static int write_config(hid_t f, const mpmc_sim sim) {
    * because the slab axis changed (sort.c, mpmc_sort_due) */
   const int axes[2] = {sim->sort_axis, sim->slab_axis};
   st |= mpmc_h5_attr_write(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
+  const mpmc_water_table *wt = &sim->wt; /* kind, gamma_w, plane; the polyline's vertices */
+  if (wt->kind != MPMC_WATER_NONE) {
+    const double w[5] = {wt->kind, wt->gamma_w, wt->plane[0], wt->plane[1], wt->plane[2]};
+    st |= mpmc_h5_attr_write(g, "water_table", H5T_NATIVE_DOUBLE, 5, w);
+    if (wt->n > 0)
+      st |= mpmc_h5_attr_write(g, "water_table_xh", H5T_NATIVE_DOUBLE, 2 * wt->n, wt->xh);
+  }
   H5Gclose(g);
   return st < 0 ? -1 : 0;
+}
+
+/* The water table (config attributes water_table and water_table_xh; absent: none).  The
+ * masses were the table's when written: they stay as they are. */
+static int read_water_table(hid_t f, mpmc_sim sim) {
+  hid_t g = H5Gopen2(f, "config", H5P_DEFAULT);
+  if (g < 0 || H5Aexists(g, "water_table") <= 0) {
+    if (g >= 0) H5Gclose(g);
+    return MPMC_SUCCESS;
+  }
+  double w[5], *xh = NULL;
+  int n = 0;
+  herr_t st = mpmc_h5_attr_read(g, "water_table", H5T_NATIVE_DOUBLE, 5, w);
+  hid_t a = H5Aexists(g, "water_table_xh") > 0 ? H5Aopen(g, "water_table_xh", H5P_DEFAULT) : -1;
+  if (a >= 0) {
+    hid_t sp = H5Aget_space(a);
+    const hssize_t np = sp >= 0 ? H5Sget_simple_extent_npoints(sp) : -1;
+    if (sp >= 0) H5Sclose(sp);
+    H5Aclose(a);
+    n = np > 0 && np % 2 == 0 && np < INT32_MAX ? (int)(np / 2) : 0;
+    xh = n ? malloc(sizeof *xh * 2 * (size_t)n) : NULL;
+    st |= xh ? mpmc_h5_attr_read(g, "water_table_xh", H5T_NATIVE_DOUBLE, 2 * n, xh) : -1;
+  }
+  H5Gclose(g);
+  const int err = st < 0 ? MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT,
+                                      "checkpoint /config: malformed water_table attributes")
+                         : mpmc_water_set(sim, (int)w[0], n, xh, w + 2, w[1], 0);
+  free(xh);
+  return err;
 }
 
 /* The configuration goes through the public setters, which validate it. */
@@ -132,6 +168,7 @@ static int read_config(hid_t f, mpmc_sim sim) {
   MPMC_CALL(mpmc_sim_set_damping(sim, damp));
   MPMC_CALL(mpmc_sim_set_kinetic_damping(sim, kd[0] != 0.0));
   sim->kd_ke = kd[1]; /* the peak test of the next step goes on as without the restart */
+  MPMC_CALL(read_water_table(f, sim));
   MPMC_CALL(mpmc_sim_set_time(sim, time));
   MPMC_CALL(mpmc_sim_set_grid(sim, lo, hi, h));
   for (int a = 0; a < sim->dim; ++a)
@@ -245,6 +282,14 @@ static int read_materials(hid_t f, mpmc_sim sim) {
       break;
     }
     memcpy(m->par0, par + (size_t)i * NPARAM, sizeof m->par0);
+    /* a parameter added to the model after the file was written (rho_sat) reads 0 there,
+     * out of its range: its default */
+    for (int k = 0; k < m->model->nstore; ++k) {
+      const mpmc_param_desc *pd = &m->model->param[k];
+      if (m->par0[k] == 0.0 && (pd->flags & MPMC_PARAM_OPTIONAL) &&
+          (pd->flags & MPMC_PARAM_LO_OPEN) && pd->lo == 0.0)
+        m->par0[k] = NAN;
+    }
     m->srm = srm[i];
     m->ops = (m->model->flags & MPMC_MODEL_CALLBACK) ? &ops_unattached : m->model->ops;
     if (!(isfinite(m->srm) && m->srm > 0))

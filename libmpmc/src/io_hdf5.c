@@ -244,7 +244,7 @@ static int write_snapshot(mpmc_output out, hid_t g, mpmc_snap *s, double *buf,
     const char *name;
     const double *a;
   } scal[] = {{"J", p->J}, {"Jbar", p->Jbar}, {"eps_p", p->eps_p}, {"region", p->region},
-                 {"mass", p->m}};
+                 {"pore_pressure", p->pw}, {"mass", p->m}};
   for (size_t k = 0; k < sizeof scal / sizeof scal[0]; ++k) {
     if (!scal[k].a) continue;
     st |= mpmc_h5_dataset_write(g, scal[k].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)n, 0,

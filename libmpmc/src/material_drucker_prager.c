@@ -4,7 +4,7 @@
 #include "material_frictional.h"
 #include "return_mc.h"
 
-enum { MATCH = MPMC_FR_NPARAM, NPARAM };
+enum { MATCH = MPMC_FR_NPARAM, RHO_SAT, NPARAM };
 
 static int dp_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
   (void)dt;
@@ -20,7 +20,8 @@ static const mpmc_param_desc params[] = {
     MPMC_PARAMS_FRICTIONAL,
     MPMC_CHOICE("match", "the cone's fit to Mohr-Coulomb: its compression or extension "
                          "meridian, or its plane-strain strength",
-                match_words, 0.0)};
+                match_words, 0.0),
+    MPMC_PARAM_RHO_SAT(MPMC_FR_RHO)};
 
 const mpmc_model mpmc_model_drucker_prager = {
     .name = "drucker_prager",
@@ -28,7 +29,7 @@ const mpmc_model mpmc_model_drucker_prager = {
     .nparam = NPARAM,
     .nstore = NPARAM,
     .param = params,
-    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_REGION,
+    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_REGION | MPMC_MODEL_EFFECTIVE,
     .strength = {MPMC_SRM_FRICTIONAL},
     .setup = mpmc_frictional_setup,
     .ops = &ops};
@@ -43,6 +44,6 @@ int mpmc_sim_add_material_drucker_prager(mpmc_sim sim, double E, double nu, doub
                                          double phi, double psi, double c_r, double phi_r,
                                          double psi_r, double eta, double sigma_t, int match,
                                          int *id) {
-  const double par[] = {E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t, match};
+  const double par[] = {E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t, match, NAN};
   return mpmc_material_add(sim, &mpmc_model_drucker_prager, par, id);
 }

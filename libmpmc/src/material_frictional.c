@@ -92,6 +92,8 @@ int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int
       p->region[q] = info.region;
       double *s = p->stress + (size_t)q * 6;
       for (int k = 0; k < 6; ++k) s[k] = tau[k] / Jm[q];
+      if (p->pw) /* effective to total stress under a water table (water.c) */
+        for (int k = 0; k < 3; ++k) s[k] -= p->pw[q];
       nret += info.plastic;
       nfb += info.fallback;
     }

@@ -193,7 +193,7 @@ static double j2_wave_speed(const mpmc_material *m) {
 
 static const mpmc_material_ops ops = {"hencky_j2", j2_update, j2_wave_speed, 1, 1};
 
-enum { E_, NU_, RHO_, KAPPA_P, KAPPA_R, ETA };
+enum { E_, NU_, RHO_, KAPPA_P, KAPPA_R, ETA, RHO_SAT };
 static const mpmc_param_desc params[] = {
     MPMC_PARAMS_ELASTIC,
     MPMC_PARAM("kappa_p", "Pa", "peak strength (von Mises q at yield)", 0.0, INFINITY,
@@ -203,6 +203,7 @@ static const mpmc_param_desc params[] = {
                KAPPA_P),
     MPMC_PARAM("eta", "1", "softening rate", 0.0, INFINITY,
                MPMC_PARAM_OPTIONAL | MPMC_PARAM_HI_OPEN, 0.0, -1, -1),
+    MPMC_PARAM_RHO_SAT(RHO_),
     MPMC_ALIAS("su", "Pa", "peak undrained shear strength (kappa_p = sqrt(3) su)", 0.0, INFINITY,
                MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, KAPPA_P, 1.7320508075688772),
     MPMC_ALIAS("su_r", "Pa", "residual undrained shear strength (kappa_r = sqrt(3) su_r)", 0.0,
@@ -220,8 +221,8 @@ static int j2_setup(mpmc_context ctx, mpmc_material *m) {
 const mpmc_model mpmc_model_hencky_j2 = {
     .name = "hencky_j2",
     .doc = "Hencky elasticity, von Mises plasticity with exponential softening (undrained clay)",
-    .nparam = 8,
-    .nstore = 6,
+    .nparam = 9,
+    .nstore = 7,
     .param = params,
     .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC,
     .strength = {[KAPPA_P] = MPMC_SRM_DIVIDE, [KAPPA_R] = MPMC_SRM_DIVIDE},
@@ -236,7 +237,7 @@ const mpmc_model mpmc_model_hencky_j2 = {
  */
 int mpmc_sim_add_material_hencky_j2(mpmc_sim sim, double E, double nu, double rho, double kappa_p,
                                     double kappa_r, double eta, int *id) {
-  const double par[] = {E, nu, rho, kappa_p, kappa_r, eta};
+  const double par[] = {E, nu, rho, kappa_p, kappa_r, eta, NAN};
   return mpmc_material_add(sim, &mpmc_model_hencky_j2, par, id);
 }
 

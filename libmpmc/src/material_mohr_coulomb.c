@@ -13,16 +13,16 @@ static int mc_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, d
 static const mpmc_material_ops ops = {"mohr_coulomb", mc_update, mpmc_frictional_wave_speed, 0,
                                       1};
 
-static const mpmc_param_desc params[] = {MPMC_PARAMS_FRICTIONAL};
+static const mpmc_param_desc params[] = {MPMC_PARAMS_FRICTIONAL, MPMC_PARAM_RHO_SAT(MPMC_FR_RHO)};
 
 const mpmc_model mpmc_model_mohr_coulomb = {
     .name = "mohr_coulomb",
     .doc = "Hencky elasticity, Mohr-Coulomb plasticity with tension cut-off and softening "
            "(drained frictional soil)",
-    .nparam = MPMC_FR_NPARAM,
-    .nstore = MPMC_FR_NPARAM,
+    .nparam = MPMC_FR_NPARAM + 1,
+    .nstore = MPMC_FR_NPARAM + 1,
     .param = params,
-    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_REGION,
+    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_REGION | MPMC_MODEL_EFFECTIVE,
     .strength = {MPMC_SRM_FRICTIONAL},
     .setup = mpmc_frictional_setup,
     .ops = &ops};
@@ -39,6 +39,6 @@ const mpmc_model mpmc_model_mohr_coulomb = {
 int mpmc_sim_add_material_mohr_coulomb(mpmc_sim sim, double E, double nu, double rho, double c,
                                        double phi, double psi, double c_r, double phi_r,
                                        double psi_r, double eta, double sigma_t, int *id) {
-  const double par[] = {E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t};
+  const double par[] = {E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t, NAN};
   return mpmc_material_add(sim, &mpmc_model_mohr_coulomb, par, id);
 }

@@ -85,7 +85,11 @@ int mpmc_material_setup(mpmc_context ctx, mpmc_material *m) {
   const mpmc_model *md = m->model;
   m->solid = (md->flags & MPMC_MODEL_SOLID) != 0;
   m->plastic = (md->flags & MPMC_MODEL_PLASTIC) != 0;
-  return md->setup ? md->setup(ctx, m) : MPMC_SUCCESS;
+  if (md->setup) MPMC_CALL(md->setup(ctx, m));
+  m->rho_sat = m->rho; /* the saturated density where the model has one (water.c) */
+  for (int k = 0; k < md->nstore; ++k)
+    if (!strcmp(md->param[k].name, "rho_sat")) m->rho_sat = m->par[k];
+  return MPMC_SUCCESS;
 }
 
 int mpmc_material_add(struct mpmc_sim_s *sim, const mpmc_model *md, const double *par_in,
@@ -120,7 +124,8 @@ int mpmc_material_add(struct mpmc_sim_s *sim, const mpmc_model *md, const double
  * @param model the model's name (mpmc_model_get_info; e.g. "hencky_j2")
  * @param par the model's stored parameters in the table's order (mpmc_model_get_param, k <
  *        nstore), in the table's units; NAN for an optional parameter takes its default
- * @param npar entries in par: the model's nstore
+ * @param npar entries in par, at most the model's nstore: the parameters after them are left
+ *        out (their defaults; an error naming the first required one)
  * @param[out] id the material's id (may be NULL)
  */
 int mpmc_sim_add_material(mpmc_sim sim, const char *model, const double *par, int npar,
@@ -131,9 +136,11 @@ int mpmc_sim_add_material(mpmc_sim sim, const char *model, const double *par, in
   MPMC_CHECK(md, ctx, MPMC_ERR_ARG, "unknown material model '%s'", model ? model : "(null)");
   MPMC_CHECK(!(md->flags & MPMC_MODEL_CALLBACK), ctx, MPMC_ERR_ARG,
              "model '%s' needs the caller's function: add it with its own constructor", md->name);
-  MPMC_CHECK(npar == md->nstore && (par || npar == 0), ctx, MPMC_ERR_ARG,
-             "model '%s' takes %d parameters, got %d", md->name, md->nstore, npar);
-  return mpmc_material_add(sim, md, par, id);
+  MPMC_CHECK(npar >= 0 && npar <= md->nstore && (par || npar == 0), ctx, MPMC_ERR_ARG,
+             "model '%s' takes at most %d parameters, got %d", md->name, md->nstore, npar);
+  double full[MPMC_MAX_PARAM];
+  for (int k = 0; k < md->nstore; ++k) full[k] = k < npar ? par[k] : NAN;
+  return mpmc_material_add(sim, md, full, id);
 }
 
 /** @brief Number of material models in the table. */

@@ -52,6 +52,8 @@ static int uy_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, d
       }
       double *s = p->stress + (size_t)q * 6;
       for (int k = 0; k < 6; ++k) s[k] = tau[k] / Jm[q];
+      if (p->pw) /* effective to total stress under a water table (water.c) */
+        for (int k = 0; k < 3; ++k) s[k] -= p->pw[q];
       nret += info.plastic;
       nfb += info.fallback;
     }
@@ -103,7 +105,7 @@ static double uy_wave_speed(const mpmc_material *m) {
 
 static const mpmc_material_ops ops = {"user_yield", uy_update, uy_wave_speed, 0, 1};
 
-static const mpmc_param_desc params[] = {MPMC_PARAMS_ELASTIC};
+static const mpmc_param_desc params[] = {MPMC_PARAMS_ELASTIC, MPMC_PARAM_RHO_SAT(2)};
 
 static int uy_setup(mpmc_context ctx, mpmc_material *m) {
   (void)ctx;
@@ -114,10 +116,10 @@ static int uy_setup(mpmc_context ctx, mpmc_material *m) {
 const mpmc_model mpmc_model_user_yield = {
     .name = "user_yield",
     .doc = "Hencky elasticity with the caller's yield surface (closest-point return)",
-    .nparam = 3,
-    .nstore = 3,
+    .nparam = 4,
+    .nstore = 4,
     .param = params,
-    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_CALLBACK,
+    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_CALLBACK | MPMC_MODEL_EFFECTIVE,
     .setup = uy_setup,
     .ops = &ops};
 
@@ -132,7 +134,7 @@ int mpmc_sim_add_material_user_yield(mpmc_sim sim, mpmc_yield_fn fn, void *data,
                                      double nu, double rho, int *id) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(fn, sim->ctx, MPMC_ERR_ARG, "user yield surface: function fn is NULL");
-  const double par[] = {E, nu, rho};
+  const double par[] = {E, nu, rho, NAN};
   int mid;
   MPMC_CALL(mpmc_material_add(sim, &mpmc_model_user_yield, par, &mid));
   sim->mats[mid].yield_fn = fn;

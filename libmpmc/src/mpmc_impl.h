@@ -73,6 +73,7 @@ typedef struct {
                     models with F-bar on): F-bar projects J / Jp, the volume change
                     that is not plastic, and hands the material Jp x the projection,
                     so that plastic dilation stays at its point (fbar.c)           */
+  double *pw;    /* [n] pore pressure of the water table (water.c; with one only)  */
   double *lp;    /* [n] uGIMP half-length, fixed at its initial value (uGIMP)      */
   double *force; /* [n][dim] external force (tractions)                           */
   double *cforce;/* [n][dim] contact force from rigid bodies (contact_barrier.c)   */
@@ -290,8 +291,15 @@ enum {
   MPMC_MODEL_PLASTIC = 2,   /* keeps eps_p per point                                     */
   MPMC_MODEL_REGION = 4,    /* keeps the return region per point                         */
   MPMC_MODEL_CALLBACK = 8,  /* needs the caller's function: added by its own constructor */
-  MPMC_MODEL_FLUID = 16     /* no elastic deviator (the energy check's density)          */
+  MPMC_MODEL_FLUID = 16,    /* no elastic deviator (the energy check's density)          */
+  MPMC_MODEL_EFFECTIVE = 32 /* stresses from the skeleton's strains are effective: a water
+                               table's pore pressure is subtracted (water.c)              */
 };
+/* The saturated density below a water table, after the model's other stored parameters;
+ * rho's by default (water.c). */
+#define MPMC_PARAM_RHO_SAT(rho_index)                                                         \
+  MPMC_PARAM("rho_sat", "kg/m^3", "saturated density (below a water table)", 0.0, INFINITY,   \
+             MPMC_PARAM_OPTIONAL | MPMC_PARAM_LO_OPEN | MPMC_PARAM_HI_OPEN, NAN, rho_index, -1)
 enum { MPMC_SRM_KEEP = 0, MPMC_SRM_DIVIDE = 1, MPMC_SRM_TAN = 2 };
 
 /* the table (material_table.c) */
@@ -315,6 +323,7 @@ struct mpmc_material_s {
   double srm;                               /* strength reduction factor applied (1)    */
   /* derived by the model's setup */
   double rho;
+  double rho_sat;                           /* below a water table (rho without one)    */
   double E, nu, K, G, lambda;               /* elastic constants                     */
   double kappa_p, kappa_r, eta;             /* J2 softening                          */
   double mu;                                /* fluid viscosity                       */
@@ -361,6 +370,29 @@ typedef struct {
  * (MPMC_ERR_UNSTABLE). */
 int mpmc_monitor_step(struct mpmc_sim_s *sim);
 
+/* ---- water table (water.c) ------------------------------------------------------------ */
+/* The piezometric elevation h over the horizontal position: a polyline h(x) (2D, and 3D
+ * extruded along y), or in 3D a plane h = a + b x + c y; the pore pressure of a point at
+ * elevation z (the last coordinate) is gamma_w max(0, h - z). */
+enum { MPMC_WATER_NONE = 0, MPMC_WATER_POLYLINE = 1, MPMC_WATER_PLANE = 2 };
+typedef struct {
+  int kind;           /* MPMC_WATER_NONE, MPMC_WATER_POLYLINE, MPMC_WATER_PLANE        */
+  int n;              /* polyline vertices                                             */
+  double *xh;         /* [n][2] (x, h), x increasing                                   */
+  double plane[3];    /* a, b, c                                                       */
+  double gamma_w;     /* unit weight of water [N/m^3]                                  */
+} mpmc_water_table;
+/* the pore pressure at position x (dim coordinates) */
+double mpmc_water_pressure(const mpmc_water_table *wt, int dim, const double *x);
+/* p->pw of every point from its position (each step before the stresses) */
+void mpmc_water_update(struct mpmc_sim_s *sim);
+/* the density of a new point of material m at x: rho_sat below the water table */
+double mpmc_water_density(const struct mpmc_sim_s *sim, const mpmc_material *m, const double *x);
+/* set (kind MPMC_WATER_NONE: remove) the water table; masses: the points' masses follow
+ * (rho_sat below, rho above), as mpmc_sim_set_water_table does, or stay (a checkpoint) */
+int mpmc_water_set(struct mpmc_sim_s *sim, int kind, int n, const double *xh,
+                   const double *plane, double gamma_w, int masses);
+
 /* ---- the simulation ---------------------------------------------------------------- */
 struct mpmc_sim_s {
   mpmc_context ctx;
@@ -370,6 +402,7 @@ struct mpmc_sim_s {
   double flip;        /* FLIP/PIC blend eta (eq 13)                                    */
   double gravity[3];
   double damping;     /* local damping alpha                                           */
+  mpmc_water_table wt; /* hydrostatic pore pressure below a phreatic line (water.c)    */
   int kdamp;          /* kinetic damping on (damping.c, mpmc_kinetic_damping)           */
   double kd_ke;       /* kinetic damping: E_k of the points after the last step; -1: none */
   int solver;

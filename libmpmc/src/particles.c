@@ -41,6 +41,7 @@ int mpmc_particles_reserve(mpmc_context ctx, mpmc_particles *p, int cap) {
   MPMC_CALL(grow(ctx, &p->eps_p, 1, cap));
   MPMC_CALL(grow(ctx, &p->region, 1, cap));
   MPMC_CALL(grow(ctx, &p->Jp, 1, cap));
+  MPMC_CALL(grow(ctx, &p->pw, 1, cap));
   MPMC_CALL(grow(ctx, &p->lp, 1, cap));
   MPMC_CALL(grow(ctx, &p->force, d, cap));
   MPMC_CALL(grow(ctx, &p->cforce, d, cap));
@@ -70,7 +71,7 @@ int mpmc_particles_ensure(mpmc_context ctx, mpmc_particles *p, double **field, i
 
 void mpmc_particles_free(mpmc_particles *p) {
   double **f[] = {&p->x,     &p->x0,    &p->v,  &p->m,      &p->vol0,   &p->J,
-                  &p->stress, &p->Jbar, &p->Janc, &p->be, &p->eps_p, &p->region, &p->Jp, &p->lp,
+                  &p->stress, &p->Jbar, &p->Janc, &p->be, &p->eps_p, &p->region, &p->Jp, &p->pw, &p->lp,
                   &p->force, &p->cforce, &p->ustate, &p->dF, &p->xn,  &p->xoff};
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
     free(*f[i]);

@@ -126,6 +126,7 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   mpmc_particles_free(&s->p);
   mpmc_grid_free(&s->grid);
   free(s->mats);
+  free(s->wt.xh);
   free(s->walls);
   free(s->mirrors);
   free(s->order);
@@ -356,7 +357,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
       p->v[q * d + a] = 0.0;
     }
     p->vol0[q] = volume[i];
-    p->m[q] = m->rho * volume[i];
+    p->m[q] = mpmc_water_density(sim, m, x + (size_t)i * d) * volume[i];
     p->J[q] = 1.0;
     for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
     p->mat[q] = material;
@@ -367,6 +368,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
     if (p->eps_p) p->eps_p[q] = 0.0;
     if (p->region) p->region[q] = 0.0;
     if (p->Jp) p->Jp[q] = 1.0;
+    if (p->pw) p->pw[q] = mpmc_water_pressure(&sim->wt, d, x + (size_t)i * d);
     if (p->lp) p->lp[q] = 0.5 * pow(volume[i], 1.0 / d);
     if (p->force)
       for (int a = 0; a < d; ++a) p->force[q * d + a] = 0.0;
@@ -411,6 +413,10 @@ int mpmc_sim_prepare(mpmc_sim sim) {
   if (region) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->region, 1, 0.0));
   /* the plastic volume ratio: with F-bar and a frictional (dilatant) model only */
   if (region && sim->fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jp, 1, 1.0));
+  if (sim->wt.kind != MPMC_WATER_NONE && !p->pw) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->pw, 1, 0.0));
+    mpmc_water_update(sim);
+  }
   if (sim->fbar && !p->Jbar) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
     for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
@@ -477,13 +483,14 @@ static double **field_ptr(mpmc_sim sim, int field, int *ncomp) {
     case MPMC_FIELD_FORCE: *ncomp = d; return &p->force;
     case MPMC_FIELD_X0: *ncomp = d; return &p->x0;
     case MPMC_FIELD_REGION: *ncomp = 1; return &p->region;
+    case MPMC_FIELD_PORE_PRESSURE: *ncomp = 1; return &p->pw;
     default: return NULL;
   }
 }
 
 static const char *field_names[MPMC_FIELD_COUNT] = {
     "position", "velocity", "mass", "volume0", "J", "Jbar", "stress", "be", "eps_p", "force", "x0",
-    "region"};
+    "region", "pore_pressure"};
 
 /**
  * @brief Borrow a particle field in place (no copy).  Layout [n][ncomp].

@@ -173,7 +173,7 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
       int nc;
     } f[] = {{p->x, d},      {p->x0, d},         {p->v, d},      {p->m, 1},
              {p->vol0, 1},   {p->J, 1},          {p->stress, 6}, {p->Jbar, 1},
-             {p->Janc, 1},   {p->be, 6},         {p->eps_p, 1},  {p->lp, 1},     {p->region, 1},  {p->Jp, 1},
+             {p->Janc, 1},   {p->be, 6},         {p->eps_p, 1},  {p->lp, 1},     {p->region, 1},  {p->Jp, 1},  {p->pw, 1},
              {p->force, d},  {p->cforce, d},     {p->ustate, p->nustate}};
     for (size_t k = 0; k < sizeof f / sizeof f[0]; ++k)
       if (f[k].a && f[k].nc > 0) permute_doubles(f[k].a, f[k].nc, perm, n, tmp, w);

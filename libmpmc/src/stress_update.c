@@ -10,6 +10,7 @@
 int mpmc_stress_update(mpmc_sim sim, double dt) {
   int err = MPMC_SUCCESS, guarded = 1;
   sim->stress_bad = INT_MAX;
+  mpmc_water_update(sim); /* the pore pressure at the points' new positions (with a table) */
   for (int m = 0; m < sim->nmat && !err; ++m) {
     err = sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, dt);
     guarded &= sim->mats[m].ops->checks_stress;
