@@ -164,7 +164,7 @@ module mpmc
     mpmc_sim_get_fbar, mpmc_sim_set_flip_blend, mpmc_sim_set_gravity, mpmc_sim_set_damping, &
     mpmc_sim_set_kinetic_damping, mpmc_sim_set_solver, mpmc_sim_set_threads, &
     mpmc_sim_set_kernels, mpmc_sim_get_kernels, mpmc_sim_set_water_table, &
-    mpmc_sim_set_water_table_plane
+    mpmc_sim_set_water_table_plane, mpmc_sim_set_geostatic_stress
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
@@ -368,6 +368,13 @@ module mpmc
       integer(c_int), value :: n
       real(c_double), intent(in) :: xh(*)
       real(c_double), value :: gamma_w
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_geostatic_stress(sim, k0) &
+        bind(C, name='mpmc_sim_set_geostatic_stress') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), value :: k0
       integer(c_int) :: ierr
     end function
     function mpmc_sim_set_water_table_plane(sim, a, b, c, gamma_w) &

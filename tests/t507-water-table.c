@@ -161,6 +161,76 @@ static void test_water_table_bad_input(void **state) {
   mpmc_context_destroy(&ctx);
 }
 
+/* mpmc_sim_set_geostatic_stress: the same Mohr-Coulomb column, its stresses set at once with
+ * K0 = nu / (1 - nu) (the column's elastic state at rest): sigma_v of the overburden,
+ * sigma'_h = K0 sigma'_v, sigma = sigma' - p; then it stays at rest (its kinetic energy over
+ * 400 steps below 1e-4 of the peak the column loaded by gravity at once reaches). */
+static double column_peak_ke(int geostatic, double *err) {
+  mpmc_context ctx;
+  mpmc_sim sim;
+  TCALL(mpmc_context_create(&ctx));
+  test_ctx = ctx;
+  TCALL(mpmc_sim_create(ctx, 2, &sim));
+  const double lo[2] = {0, 0}, hi[2] = {W, H + 2 * h};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  TCALL(mpmc_sim_set_basis(sim, MPMC_BASIS_UGIMP));
+  TCALL(mpmc_sim_set_fbar(sim, MPMC_FBAR_ANCHORED));
+  const double gv[2] = {0, -G};
+  TCALL(mpmc_sim_set_gravity(sim, gv));
+  const double par[] = {E, NU, RHO, 1e7, 30, 0, NAN, NAN, NAN, NAN, NAN, RHO_SAT};
+  int mat;
+  TCALL(mpmc_sim_add_material(sim, "mohr_coulomb", par, 12, &mat));
+  const double xh[2] = {0.0, HW};
+  TCALL(mpmc_sim_set_water_table(sim, 1, xh, GW));
+  double *x, *vol;
+  const double plo[2] = {0, 0}, phi[2] = {W, H};
+  const int n = test_lattice(2, plo, phi, h, 2, &x, &vol);
+  TCALL(mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
+  TCALL(mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
+  TCALL(mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
+  TCALL(mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  const double k0 = NU / (1 - NU);
+  *err = 0.0;
+  if (geostatic) {
+    TCALL(mpmc_sim_set_geostatic_stress(sim, k0));
+    double *sig, *pw;
+    TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL));
+    TCALL(mpmc_sim_get_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL));
+    for (int q = 0; q < n; ++q) {
+      const double y = x[2 * q + 1], sv = sigma_v(y), p = pore(y), sh = k0 * (sv + p) - p;
+      const double e = fmax(fabs(sig[6 * q + 1] - sv), fabs(sig[6 * q] - sh)) / (RHO_SAT * G * H);
+      if (e > *err) *err = e;
+    }
+  }
+  double dt, kemax = 0.0;
+  TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
+  for (int s = 0; s < 400; ++s) {
+    TCALL(mpmc_sim_step(sim, dt));
+    double ke;
+    TCALL(mpmc_sim_get_kinetic_energy(sim, &ke));
+    if (ke > kemax) kemax = ke;
+  }
+  free(x);
+  free(vol);
+  mpmc_sim_destroy(&sim);
+  mpmc_context_destroy(&ctx);
+  test_ctx = NULL;
+  return kemax;
+}
+
+static void test_geostatic_column(void **state) {
+  (void)state;
+  double err0, err;
+  const double ke_gravity = column_peak_ke(0, &err0), ke_k0 = column_peak_ke(1, &err);
+  if (getenv("MPMC_TEST_VERBOSE"))
+    printf("geostatic: stress error %.2e of rho_sat g H; peak E_k %.3e J (gravity at once %.3e J)\n",
+           err, ke_k0, ke_gravity);
+  /* the columns' half-point overburden is exact on the lattice: the error is round-off */
+  if (!(err < 1e-12) || !(ke_k0 < 1e-4 * ke_gravity))
+    fail_msg("geostatic column: stress error %.2e (< 1e-12), peak E_k %.3e J (< 1e-4 of %.3e J)",
+             err, ke_k0, ke_gravity);
+}
+
 /* 3D: the plane h = a + b x + c y gives each point its pressure and density */
 static void test_plane_3d(void **state) {
   (void)state;
@@ -193,6 +263,7 @@ static void test_plane_3d(void **state) {
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_effective_stress_column),
                                      cmocka_unit_test(test_total_stress_column),
+                                     cmocka_unit_test(test_geostatic_column),
                                      cmocka_unit_test(test_plane_3d),
                                      cmocka_unit_test(test_water_table_bad_input)};
   return cmocka_run_group_tests(tests, NULL, NULL);

@@ -189,6 +189,13 @@ static void test_bad_override(void **state) {
   const char *wok[] = {"water_table={points: [[0, 0.5], [2, 0.5]]}", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-water", 2, wok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
   if (e != 0) fail_msg("--set water_table points: expected success, got %d: %s", e, msg);
+  const char *k0[] = {"stages.0.initial_stress={k0: -1}"};
+  e = run_lib(scene, DIR "/out-override", 1, k0, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set stages.0.initial_stress k0 = -1: expected a failure, got 0");
+  test_expect_in("--set initial_stress", msg, "key 'stages.0.initial_stress.k0': must be > 0 (got -1)");
+  const char *k0ok[] = {"stages.0.initial_stress={k0: 0.5}", "stages.0.end.time=0.0005"};
+  e = run_lib(scene, DIR "/out-k0", 2, k0ok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e != 0) fail_msg("--set stages.0.initial_stress={k0: 0.5}: expected success, got %d: %s", e, msg);
   /* an empty list of snapshot plots is none, not an error; sorting every step runs */
   const char *none[] = {"snapshot_plots=[]", "sort_interval=1", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-noplots", 3, none, MPMC_WORKFLOW_FORCE, msg, sizeof msg);

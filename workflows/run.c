@@ -354,6 +354,7 @@ static void log_plan(const wf_run *w) {
                s->strength_reduction);
     if (s->damping > 0) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", damping %g", s->damping);
     if (s->kinetic_damping) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", kinetic damping");
+    if (s->k0 > 0) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", geostatic stress K0 = %g", s->k0);
     if (s->nwalls) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", +%d walls", s->nwalls);
     if (s->nremove) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", -%d walls", s->nremove);
     say(w, "stage %d/%d %s: %s%s", i + 1, sc->nstage, s->name, end, extra);
@@ -445,6 +446,8 @@ static int stage_setup(wf_run *w, int i) {
            "stages.%d.strength_reduction", i);
     w->strength = s->strength_reduction;
   }
+  if (s->k0 > 0) /* after the stage's gravity and strengths, before its first step */
+    WF_TRY(w, mpmc_sim_set_geostatic_stress(sim, s->k0), "stages.%d.initial_stress", i);
   if (s->reset_velocity) {
     double *v;
     int np;

@@ -966,7 +966,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   sc->nstage = ss->n;
   sc->stages = calloc((size_t)ss->n, sizeof *sc->stages);
   if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
-  static const char *const keys[] = {"name", "gravity", "damping", "kinetic_damping", "flip", "walls", "remove_walls", "tractions",
+  static const char *const keys[] = {"name", "gravity", "damping", "kinetic_damping", "initial_stress", "flip", "walls", "remove_walls", "tractions",
                                      "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
                                      "snapshots", "series_points", "rigid_bodies", "force_dt",
                                      "factor_of_safety", NULL};
@@ -1001,6 +1001,12 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     const range fac = {0, 1, 1, 0};
     if (get_num(r, n, p, "dt_factor", 0, 0.3, fac, &s->dt_factor)) return -1;
     if (get_num(r, n, p, "dt", 0, 0, NONNEG, &s->dt)) return -1;
+    const wf_node *is = map_get(n, "initial_stress");
+    if (is) {
+      static const char *const ik[] = {"k0", NULL};
+      join(full, sizeof full, p, "initial_stress");
+      if (check_map(r, is, full, ik) || get_num(r, is, full, "k0", 1, 0, POS, &s->k0)) return -1;
+    }
     if (get_int(r, n, p, "snapshots", 0, 4, 0, 100000, &s->snapshots)) return -1;
     if (get_int(r, n, p, "series_points", 0, 200, 1, 10000000, &s->series_points)) return -1;
     char wp[128];

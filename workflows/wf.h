@@ -118,6 +118,7 @@ typedef struct {
   double gravity[3];
   double damping;
   int kinetic_damping; /* velocities to zero at each peak of E_k (mpmc_sim_set_kinetic_damping) */
+  double k0;           /* initial_stress.k0: the geostatic state at the stage's start; 0: none */
   double flip; /* the stage's FLIP/PIC blend (the scene's where the stage sets none) */
   int nwalls;
   wf_wall *walls;

@@ -197,6 +197,12 @@ int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on); /* 0 off, 1 on */
 int mpmc_sim_set_water_table(mpmc_sim sim, int n, const double *xh, double gamma_w);
 /* 3D: the piezometric plane h = a + b x + c y. */
 int mpmc_sim_set_water_table_plane(mpmc_sim sim, double a, double b, double c, double gamma_w);
+/* The geostatic state at once, under the current gravity (along -z): each soil point's
+ * vertical stress from the overburden of its column of points, the horizontal ones K0
+ * times it (effective stresses under a water table for the effective models), and the
+ * elastic strain that carries them.  Points of models without Hencky elasticity are left
+ * as they are. */
+int mpmc_sim_set_geostatic_stress(mpmc_sim sim, double k0);
 int mpmc_sim_set_solver(mpmc_sim sim, int solver);
 int mpmc_sim_set_threads(mpmc_sim sim, int nthreads);
 int mpmc_sim_set_kernels(mpmc_sim sim, int kernels);      /* mpmc_kernels */

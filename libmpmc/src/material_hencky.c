@@ -31,7 +31,7 @@ const mpmc_model mpmc_model_hencky = {
     .nparam = 3,
     .nstore = 3,
     .param = params,
-    .flags = MPMC_MODEL_SOLID,
+    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_HENCKY,
     .setup = hencky_setup,
     .ops = &ops};
 

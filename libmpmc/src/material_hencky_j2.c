@@ -224,7 +224,7 @@ const mpmc_model mpmc_model_hencky_j2 = {
     .nparam = 9,
     .nstore = 7,
     .param = params,
-    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC,
+    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_HENCKY,
     .strength = {[KAPPA_P] = MPMC_SRM_DIVIDE, [KAPPA_R] = MPMC_SRM_DIVIDE},
     .setup = j2_setup,
     .ops = &ops};

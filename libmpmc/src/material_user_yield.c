@@ -119,7 +119,7 @@ const mpmc_model mpmc_model_user_yield = {
     .nparam = 4,
     .nstore = 4,
     .param = params,
-    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_CALLBACK | MPMC_MODEL_EFFECTIVE,
+    .flags = MPMC_MODEL_SOLID | MPMC_MODEL_PLASTIC | MPMC_MODEL_CALLBACK | MPMC_MODEL_EFFECTIVE | MPMC_MODEL_HENCKY,
     .setup = uy_setup,
     .ops = &ops};
 

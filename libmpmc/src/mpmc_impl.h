@@ -292,8 +292,9 @@ enum {
   MPMC_MODEL_REGION = 4,    /* keeps the return region per point                         */
   MPMC_MODEL_CALLBACK = 8,  /* needs the caller's function: added by its own constructor */
   MPMC_MODEL_FLUID = 16,    /* no elastic deviator (the energy check's density)          */
-  MPMC_MODEL_EFFECTIVE = 32 /* stresses from the skeleton's strains are effective: a water
+  MPMC_MODEL_EFFECTIVE = 32, /* stresses from the skeleton's strains are effective: a water
                                table's pore pressure is subtracted (water.c)              */
+  MPMC_MODEL_HENCKY = 64    /* Hencky elasticity on b_e (geostatic.c sets its state)       */
 };
 /* The saturated density below a water table, after the model's other stored parameters;
  * rho's by default (water.c). */
