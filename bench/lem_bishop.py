@@ -1,19 +1,19 @@
 #!/usr/bin/env python3
-"""Bishop's simplified method of slices, a circular-surface search: the limit-equilibrium
-reference for the slopes of docs/error_vs_runtime.md (the factor-of-safety search).
+"""Bishop's simplified method of slices with a search over circles: the limit-equilibrium
+reference of the factor-of-safety benchmarks (docs/error_vs_runtime.md).
 
-    bench/lem_bishop.py [--water x,h x,h ...] [--gamma-w 9.81]
+    bench/lem_bishop.py [--ground x,y ...] [--gamma kN/m3] [--c kPa] [--phi deg]
+                        [--water x,h ...] [--gamma-w kN/m3] [--back x]
 
-The slope of workflows/slope_griffiths_lane.yaml (Griffiths & Lane 1999, example 1):
-H = 10 m, 2:1, crest 12 m wide behind the top, firm base at the toe's level,
-gamma = 20 kN/m^3, c' = 10 kPa, phi' = 20 deg.  With --water, the pore pressure on each
-slice's base is gamma_w (h(x) - y) below the piezometric line through the given (x, h)
-points.  Prints the lowest factor of safety found and its circle.  Units kN, m."""
+Defaults: the slope of workflows/slope_griffiths_lane.yaml (Griffiths & Lane 1999, ex. 1):
+ground (0,10) (12,10) (32,0) (45,0), gamma = 20 kN/m^3, c' = 10 kPa, phi' = 20 deg, the
+back boundary at x = 0.  Slopes face +x; the firm base is y = 0 (no circle below it) and
+no circle reaches behind the back boundary.  With --water, the pore pressure on a slice's
+base is gamma_w (h(x) - y) below the piezometric line through the given (x, h) points
+(constant beyond its ends).  With phi = 0 the method is the undrained (Fellenius = Bishop)
+circle analysis of Taylor's charts.  Prints the lowest factor of safety and its circle."""
 import argparse
 import math
-
-GROUND = [(0.0, 10.0), (12.0, 10.0), (32.0, 0.0), (45.0, 0.0)]
-GAMMA, C, PHI = 20.0, 10.0, math.radians(20.0)
 
 
 def interp(pts, x):
@@ -25,68 +25,100 @@ def interp(pts, x):
     return pts[-1][1]
 
 
-def bishop(xc, yc, r, water, gw, nslice=150):
-    """F of the circle (xc, yc, r), or None when it does not cut a valid mass."""
-    if yc - r < -1e-9:  # the firm base: no circle below it
+def crossings(ground, xc, yc, r):
+    """x where the lower arc y = yc - sqrt(r^2 - (x - xc)^2) meets the ground polyline."""
+    xs = []
+    for (x0, y0), (x1, y1) in zip(ground, ground[1:]):
+        # points (x0 + t dx, y0 + t dy), t in [0, 1], at distance r from the centre
+        dx, dy = x1 - x0, y1 - y0
+        fx, fy = x0 - xc, y0 - yc
+        a, b, c = dx * dx + dy * dy, 2 * (fx * dx + fy * dy), fx * fx + fy * fy - r * r
+        disc = b * b - 4 * a * c
+        if disc < 0:
+            continue
+        for t in ((-b - math.sqrt(disc)) / (2 * a), (-b + math.sqrt(disc)) / (2 * a)):
+            if 0 <= t <= 1 and y0 + t * dy <= yc:
+                xs.append(x0 + t * dx)
+    return sorted(xs)
+
+
+def bishop(a, xc, yc, r, nslice):
+    if yc - r < -1e-9:  # the firm base
         return None
-    # the arc's extent under the ground surface
-    xs = [xc - r + 2 * r * k / 2000 for k in range(2001)]
-    inside = [x for x in xs if x >= 0 and yc - math.sqrt(max(r * r - (x - xc) ** 2, 0)) < interp(GROUND, x)]
-    if len(inside) < 10:
+    xs = crossings(a.ground, xc, yc, r)
+    if len(xs) < 2:
         return None
-    xa, xb = min(inside), max(inside)
-    if xa <= 0.0 + 1e-9:  # reaches the back boundary
+    xa, xb = xs[0], xs[-1]
+    if xa < a.back or xb - xa < 0.5:
         return None
+    tphi = math.tan(math.radians(a.phi))
     b = (xb - xa) / nslice
     sl = []
     for k in range(nslice):
         x = xa + (k + 0.5) * b
         yb = yc - math.sqrt(max(r * r - (x - xc) ** 2, 0.0))
-        ys = interp(GROUND, x)
+        ys = interp(a.ground, x)
         if ys <= yb:
-            continue
-        w = GAMMA * b * (ys - yb)
+            return None  # the arc leaves the ground between its ends: not one mass
         sa = (xc - x) / r
         ca = math.sqrt(max(1 - sa * sa, 1e-12))
-        u = gw * max(0.0, interp(water, x) - yb) if water else 0.0
-        sl.append((w, sa, ca, u))
+        u = a.gamma_w * max(0.0, interp(a.water, x) - yb) if a.water else 0.0
+        sl.append((a.gamma * b * (ys - yb), sa, ca, u))
     drive = sum(w * sa for w, sa, _, _ in sl)
     if drive <= 0:
         return None
     f = 1.5
-    for _ in range(100):
-        res = sum((C * b + max(w - u * b, 0.0) * math.tan(PHI)) / (ca + sa * math.tan(PHI) / f)
-                  for w, sa, ca, u in sl)
+    for _ in range(200):
+        res = sum((a.c * b + max(w - u * b, 0.0) * tphi) / (ca + sa * tphi / f) for w, sa, ca, u in sl)
         fn = res / drive
-        if abs(fn - f) < 1e-6:
-            break
+        if abs(fn - f) < 1e-7:
+            return fn
         f = fn
     return fn
 
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--ground", nargs="+", default=["0,10", "12,10", "32,0", "45,0"])
+    ap.add_argument("--gamma", type=float, default=20.0)
+    ap.add_argument("--c", type=float, default=10.0)
+    ap.add_argument("--phi", type=float, default=20.0)
     ap.add_argument("--water", nargs="*", default=None)
     ap.add_argument("--gamma-w", type=float, default=9.81)
+    ap.add_argument("--back", type=float, default=0.0)
     a = ap.parse_args()
-    water = [tuple(map(float, p.split(","))) for p in a.water] if a.water else None
+    pts = lambda ps: [tuple(map(float, p.split(","))) for p in ps]
+    a.ground = pts(a.ground)
+    a.water = pts(a.water) if a.water else None
+    hmax = max(y for _, y in a.ground)
+    x0, x1 = a.ground[0][0], a.ground[-1][0]
     best = (1e9, None)
-    # coarse grid, then refined around the best centre
-    for it, (xr, yr, step) in enumerate([((5, 40), (8, 40), 1.0), (None, None, 0.2), (None, None, 0.05)]):
-        if it:
-            _, (bx, by, br) = best
-            xr, yr = (bx - 5 * step, bx + 5 * step), (by - 5 * step, by + 5 * step)
-        nx, ny = int(round((xr[1] - xr[0]) / step)) + 1, int(round((yr[1] - yr[0]) / step)) + 1
+    # centres over a grid above the slope, radii from small to tangent with the base; then
+    # twice refined around the best circle
+    step = (x1 - x0) / 40
+    grid = ((x0, x1), (0.5 * hmax, 4 * hmax))
+    for it in range(3):
+        (xa, xb), (ya, yb) = grid
+        nx, ny = int(round((xb - xa) / step)) + 1, int(round((yb - ya) / step)) + 1
         for i in range(nx):
-            xc = xr[0] + i * step
+            xc = xa + i * step
             for j in range(ny):
-                yc = yr[0] + j * step
-                for k in range(1, 41):
-                    r = yc * k / 40  # down to tangent with the base
-                    f = bishop(xc, yc, r, water, a.gamma_w, 60 if it == 0 else 150)
+                yc = ya + j * step
+                if yc <= 0:
+                    continue
+                for k in range(1, 61):
+                    r = yc * k / 60
+                    f = bishop(a, xc, yc, r, 40 if it == 0 else 200)
                     if f is not None and f < best[0]:
                         best = (f, (xc, yc, r))
+        if best[1] is None:
+            break
+        bx, by, _ = best[1]
+        grid = ((bx - 4 * step, bx + 4 * step), (by - 4 * step, by + 4 * step))
+        step /= 4
+    # the best circle again with many slices
     f, (xc, yc, r) = best
+    f = bishop(a, xc, yc, r, 1000) or f
     print(f"Bishop simplified: F = {f:.3f}, circle centre ({xc:.2f}, {yc:.2f}), radius {r:.2f} m")
 
 
