@@ -353,19 +353,23 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights4(const int DIM, const int BASIS, con
  * outlined loop as run-time values and the basis switch would stay in the hot loop. */
 #define MPMC_KERNELS(X) X(2, 0) X(2, 1) X(2, 2) X(2, 3) X(3, 0) X(3, 1) X(3, 2) X(3, 3)
 
-/* Call fn##D##_##B(args...) for the simulation's dimension and basis. */
-#define MPMC_KERNEL_CALL(fn, sim, ...)                  \
-  do {                                                  \
-    switch ((sim)->dim * 4 + (sim)->basis) {            \
-      case 8: fn##2_0(__VA_ARGS__); break;              \
-      case 9: fn##2_1(__VA_ARGS__); break;              \
-      case 10: fn##2_2(__VA_ARGS__); break;             \
-      case 11: fn##2_3(__VA_ARGS__); break;             \
-      case 12: fn##3_0(__VA_ARGS__); break;             \
-      case 13: fn##3_1(__VA_ARGS__); break;             \
-      case 14: fn##3_2(__VA_ARGS__); break;             \
-      default: fn##3_3(__VA_ARGS__); break;             \
-    }                                                   \
+/* Call fn##D##_##B(args...) for the simulation's dimension and basis.  The switch key is
+ * unique for every (dim, basis) pair, whatever bases are added (dim < 4); a new basis needs
+ * its instances in MPMC_KERNELS and its cases here (the assertion below is the reminder). */
+#define MPMC_DIM_BASIS(d, b) ((b) * 4 + (d))
+_Static_assert(MPMC_BASIS_BSPLINE3 == 3, "a new basis: add its kernel instances and cases");
+#define MPMC_KERNEL_CALL(fn, sim, ...)                                  \
+  do {                                                                  \
+    switch (MPMC_DIM_BASIS((sim)->dim, (sim)->basis)) {                 \
+      case MPMC_DIM_BASIS(2, 0): fn##2_0(__VA_ARGS__); break;           \
+      case MPMC_DIM_BASIS(2, 1): fn##2_1(__VA_ARGS__); break;           \
+      case MPMC_DIM_BASIS(2, 2): fn##2_2(__VA_ARGS__); break;           \
+      case MPMC_DIM_BASIS(2, 3): fn##2_3(__VA_ARGS__); break;           \
+      case MPMC_DIM_BASIS(3, 0): fn##3_0(__VA_ARGS__); break;           \
+      case MPMC_DIM_BASIS(3, 1): fn##3_1(__VA_ARGS__); break;           \
+      case MPMC_DIM_BASIS(3, 2): fn##3_2(__VA_ARGS__); break;           \
+      default: fn##3_3(__VA_ARGS__); break; /* MPMC_DIM_BASIS(3, 3) */  \
+    }                                                                   \
   } while (0)
 
 #endif
