@@ -196,6 +196,11 @@ static void test_bad_override(void **state) {
   const char *k0ok[] = {"stages.0.initial_stress={k0: 0.5}", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-k0", 2, k0ok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
   if (e != 0) fail_msg("--set stages.0.initial_stress={k0: 0.5}: expected success, got %d: %s", e, msg);
+  const char *ro[] = {"metrics={runout_distance: {material: nope}}"};
+  e = run_lib(scene, DIR "/out-override", 1, ro, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set metrics.runout_distance.material=nope: expected a failure, got 0");
+  test_expect_in("--set runout material", msg,
+                 "key 'metrics.runout_distance.material': no material named 'nope' in materials");
   /* an empty list of snapshot plots is none, not an error; sorting every step runs */
   const char *none[] = {"snapshot_plots=[]", "sort_interval=1", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-noplots", 3, none, MPMC_WORKFLOW_FORCE, msg, sizeof msg);

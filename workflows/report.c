@@ -5,7 +5,8 @@
  * x_toe is `metrics.runout_distance.toe` or, when not given, the largest initial coordinate
  * of any material point along that axis (a slope standing on the grid floor).  The run-out
  * distance is max(0, max_p x_p - x_toe): how far the farthest material has travelled beyond
- * the initial toe. */
+ * the initial toe.  With `material`, only that material's points count for both (the fill
+ * of a slope on a foundation layer that reaches beyond the toe). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -71,9 +72,14 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
   mpmc_sim_get_num_particles(sim, &np);
   if ((e = mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL))) return e;
   const int d = sc->dim;
+  const int *mat = NULL; /* the points of the run-out's material only, when it names one */
+  if (m->enabled[WF_METRIC_RUNOUT] && m->runout_material >= 0 && (e = mpmc_sim_get_material_ids(sim, &mat)))
+    return e;
+  const int slide = m->runout_material >= 0 ? sc->mats[m->runout_material].id : -1;
   if (m->enabled[WF_METRIC_RUNOUT] && !m->has_toe) {
     double toe = -INFINITY;
-    for (int q = 0; q < np; ++q) toe = fmax(toe, x0[(size_t)q * d + m->runout_axis]);
+    for (int q = 0; q < np; ++q)
+      if (!mat || mat[q] == slide) toe = fmax(toe, x0[(size_t)q * d + m->runout_axis]);
     sc->metrics.toe = toe;
   }
   if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {
@@ -104,8 +110,12 @@ static int metrics_of_fields(mpmc_sim sim, const wf_scene *sc, double *v) {
   const int d = sc->dim;
   for (int k = 0; k < WF_METRIC_COUNT; ++k) v[k] = NAN;
   if (m->enabled[WF_METRIC_RUNOUT]) {
+    const int *mat = NULL;
+    if (m->runout_material >= 0 && (e = mpmc_sim_get_material_ids(sim, &mat))) return e;
+    const int slide = m->runout_material >= 0 ? sc->mats[m->runout_material].id : -1;
     double front = -INFINITY;
-    for (int q = 0; q < np; ++q) front = fmax(front, x[(size_t)q * d + m->runout_axis]);
+    for (int q = 0; q < np; ++q)
+      if (!mat || mat[q] == slide) front = fmax(front, x[(size_t)q * d + m->runout_axis]);
     v[WF_METRIC_RUNOUT] = fmax(0.0, front - m->toe);
   }
   if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {

@@ -1232,7 +1232,7 @@ static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
                                      "center_of_mass_x", "bearing_capacity_ratio", "surge_front_x",
                                      "hydrostatic_pressure_error", NULL};
   if (check_map(r, m, "metrics", keys)) return -1;
-  static const char *const rk[] = {"toe", "axis", NULL};
+  static const char *const rk[] = {"toe", "axis", "material", NULL};
   static const char *const tk[] = {"point", NULL};
   static const char *const none[] = {NULL};
   for (int i = 0; i < m->n; ++i) {
@@ -1244,8 +1244,19 @@ static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
                                                               !strcmp(v->value, "null"));
     if (!strcmp(m->keys[i], "runout_distance")) {
       sc->metrics.enabled[WF_METRIC_RUNOUT] = 1;
+      sc->metrics.runout_material = -1;
       if (empty) continue;
       if (check_map(r, v, p, rk)) return -1;
+      const wf_node *mn = map_get(v, "material");
+      if (mn) { /* the slide's material (a foundation layer beyond the toe does not run out) */
+        char full[160];
+        snprintf(full, sizeof full, "%s.material", p);
+        if (mn->kind != WF_SCALAR) return fail_at(r, mn, full, "expected a material name");
+        for (int k = 0; k < sc->nmat; ++k)
+          if (!strcmp(sc->mats[k].name, mn->value)) sc->metrics.runout_material = k;
+        if (sc->metrics.runout_material < 0)
+          return fail_at(r, mn, full, "no material named '%s' in materials", mn->value);
+      }
       sc->metrics.has_toe = map_get(v, "toe") != NULL;
       if (get_num(r, v, p, "toe", 0, 0, ANY, &sc->metrics.toe)) return -1;
       if (get_enum(r, v, p, "axis", 0, 0, axis_words, &sc->metrics.runout_axis)) return -1;

@@ -150,6 +150,7 @@ typedef struct {
   int enabled[WF_METRIC_COUNT];
   int has_toe;
   double toe;                /* runout: initial toe abscissa                        */
+  int runout_material;       /* runout: only this scene material's points; -1: all  */
   int runout_axis;
   double point[3];           /* tip displacement: the point whose motion is tracked */
   int tip_id;                /* id of the nearest material point (set at run time)  */
