@@ -3,6 +3,7 @@
 ! computes with, and values the C step writes appear through the same pointer.
 program t111_fields_f
   use, intrinsic :: iso_c_binding, only: c_int, c_double, c_loc, c_associated, c_ptr
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use mpmc
   implicit none
   real(c_double), parameter :: rho = 1000.0_c_double, vol = 0.0625_c_double
@@ -146,6 +147,35 @@ program t111_fields_f
 
   deallocate (name) ! main-program variables are not freed automatically
   call ok(mpmc_sim_destroy(sim), 'destroy sim')
+
+  ! a water table and the geostatic state from Fortran: a Mohr-Coulomb column of two points
+  ! (E nu rho c phi psi c_r phi_r psi_r eta sigma_t rho_sat; NaN takes a default), the
+  ! phreatic line at 3 m: the point at 1 m below it weighs rho_sat and carries
+  ! p = 9810 * 2 Pa, the point at 3.5 m weighs rho and carries none
+  call ok(mpmc_sim_create(ctx, 2_c_int, sim), 'water sim')
+  call ok(mpmc_sim_set_grid(sim, [0.0_c_double, 0.0_c_double], [4.0_c_double, 4.0_c_double], &
+    0.5_c_double), 'water grid')
+  call ok(mpmc_sim_add_material(sim, 'mohr_coulomb', [1.0e7_c_double, 0.3_c_double, 1800.0_c_double, &
+    1.0e4_c_double, 30.0_c_double, 0.0_c_double, ieee_value(1.0_c_double, ieee_quiet_nan), &
+    ieee_value(1.0_c_double, ieee_quiet_nan), ieee_value(1.0_c_double, ieee_quiet_nan), &
+    0.0_c_double, ieee_value(1.0_c_double, ieee_quiet_nan), 2100.0_c_double], mat), 'water material')
+  call ok(mpmc_sim_set_water_table(sim, 1_c_int, [0.0_c_double, 3.0_c_double], 9810.0_c_double), &
+    'water table')
+  call ok(mpmc_sim_add_particles(sim, 2_c_int, reshape([1.0_c_double, 1.0_c_double, 1.0_c_double, &
+    3.5_c_double], [2, 2]), [vol, vol], mat, first), 'water points')
+  call ok(mpmc_sim_set_gravity(sim, [0.0_c_double, -9.81_c_double]), 'water gravity')
+  call ok(mpmc_sim_set_geostatic_stress(sim, 0.5_c_double), 'geostatic stress')
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_MASS, m), 'water mass')
+  call expect_close('saturated mass', 2100.0_c_double*vol, m(1), 1.0e-14_c_double)
+  call expect_close('dry mass', 1800.0_c_double*vol, m(2), 1.0e-14_c_double)
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_PORE_PRESSURE, x1d), 'pore pressure')
+  call expect_close('pore pressure below', 2.0_c_double*9810.0_c_double, x1d(1), 1.0e-14_c_double)
+  call expect_close('pore pressure above', 0.0_c_double, x1d(2), 0.0_c_double)
+  call ok(mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, s), 'geostatic stresses')
+  call check(s(2, 1) < 0.0_c_double .and. s(2, 2) < 0.0_c_double, 'geostatic sigma_yy compressive')
+  ! the top point: sigma_h = K0 sigma_v (dry, effective = total)
+  call expect_close('geostatic sigma_xx = K0 sigma_yy', 0.5_c_double*s(2, 2), s(1, 2), 1.0e-12_c_double)
+  call ok(mpmc_sim_destroy(sim), 'destroy water sim')
   call ok(mpmc_context_destroy(ctx), 'destroy context')
   if (nfail > 0) error stop 1
 
