@@ -34,15 +34,7 @@ enum { S_A = 0, S_B, S_C, S_T1, S_T2, S_T3, S_DP };
  * B compression edge partner (2-3), C extension edge partner (1-2) */
 static const int mc_ij[3][2] = {{0, 2}, {1, 2}, {0, 1}};
 
-/* the material at eps_p and the derivatives in eps_p */
-typedef struct {
-  double c, sf, cf, ss, cs;     /* c, sin/cos phi, sin/cos psi     */
-  double dc, dphi, dsf, dcf, dss; /* d/d eps_p                       */
-  double eta, xi, etab;         /* Drucker-Prager: eta_f(phi), xi(phi), eta_f(psi) */
-  double deta, dxi, detab;
-  double st, dst;               /* cut-off, capped at the apex     */
-  int st_apex;                  /* 1 when the cap (the apex) is the cut-off */
-} mc_mat;
+typedef mpmc_mc_mat mc_mat; /* the material at eps_p (return_mc.h) */
 
 /* One region's problem. */
 typedef struct {
@@ -59,39 +51,72 @@ typedef struct {
   double yscale;  /* typical size of a multiplier (strain)                */
 } mc_sys;
 
-/* Drucker-Prager's eta_f, xi of one matching at phi and their phi-derivatives. */
-static void dp_coef(int surface, double phi, double *eta, double *xi, double *deta,
+/* Drucker-Prager's eta_f, xi of one matching at an angle of sine s, cosine c and their
+ * derivatives in the angle. */
+static void dp_coef(int surface, double s, double c, double *eta, double *xi, double *deta,
                     double *dxi) {
-  const double s = sin(phi), c = cos(phi), r3 = sqrt(3.0);
   if (surface == MPMC_DP_PLANE_STRAIN) {
-    const double t = tan(phi), w = 9.0 + 12.0 * t * t, sw = sqrt(w), dt = 1.0 / (c * c);
-    *eta = 3.0 * t / sw;
-    *xi = 3.0 / sw;
-    *deta = 27.0 / (w * sw) * dt;
-    *dxi = -36.0 * t / (w * sw) * dt;
+    const double ic = 1.0 / c, t = s * ic, w = 9.0 + 12.0 * t * t, sw = sqrt(w);
+    const double isw = 1.0 / sw, iw = isw * isw * isw * ic * ic; /* 1 / (w sw c^2) */
+    *eta = 3.0 * t * isw;
+    *xi = 3.0 * isw;
+    *deta = 27.0 * iw;
+    *dxi = -36.0 * t * iw;
     return;
   }
+  const double k = 3.4641016151377546; /* 6 / sqrt3 */
   const double g = surface == MPMC_DP_COMPRESSION ? 3.0 - s : 3.0 + s;
   const double dg = surface == MPMC_DP_COMPRESSION ? -c : c; /* dg/dphi */
-  *eta = 6.0 * s / (r3 * g);
-  *xi = 6.0 * c / (r3 * g);
-  *deta = 6.0 / r3 * (c * g - s * dg) / (g * g);
-  *dxi = 6.0 / r3 * (-s * g - c * dg) / (g * g);
+  const double ig = 1.0 / g, kig = k * ig, kig2 = kig * ig;
+  *eta = s * kig;
+  *xi = c * kig;
+  *deta = (c * g - s * dg) * kig2;
+  *dxi = (-s * g - c * dg) * kig2;
 }
 
-/* x(eps_p) = x_r + (x_p - x_r) e with e = exp(-eta eps_p); derivative -eta (x_p - x_r) e */
-static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q) {
+/* sin x, cos x from those of a nearby x0 (the material at eps_p^n during a return, where
+ * the angles move by ~eta D (phi_p - phi_r), D ~ 1e-3): the addition theorem with the
+ * Taylor series of d = x - x0, whose first omitted terms d^11/11!, d^12/12! are below
+ * 2^-53 |d|, 2^-53 for |d| <= 0.1 (a few times cheaper than libm's sincos; the same to
+ * ~1 ulp).  Farther, libm. */
+static inline void sin_cos_near(double x, double x0, double s0, double c0, double *s,
+                                double *c) {
+  const double d = x - x0;
+  if (!(fabs(d) <= 0.1)) {
+    *s = sin(x);
+    *c = cos(x);
+    return;
+  }
+  const double d2 = d * d;
+  const double sd = /* sin d */
+      d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880 + d2 * (-1.0 / 39916800)))));
+  const double cm = /* 1 - cos d */
+      d2 * (0.5 + d2 * (-1.0 / 24 + d2 * (1.0 / 720 + d2 * (-1.0 / 40320 + d2 * (1.0 / 3628800)))));
+  *s = s0 + (c0 * sd - s0 * cm);
+  *c = c0 - (s0 * sd + c0 * cm);
+}
+
+/* x(eps_p) = x_r + (x_p - x_r) e with e = exp(-eta eps_p); derivative -eta (x_p - x_r) e.
+ * ref: a material near this one (may be NULL), whose sines and cosines seed this one's. */
+static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q, const mc_mat *ref) {
   const double de = frozen ? 0.0 : -m->eta * e; /* de/d eps_p */
   const double phi = m->phi_r + (m->phi_p - m->phi_r) * e;
   const double psi = m->psi_r + (m->psi_p - m->psi_r) * e;
+  q->phi = phi;
+  q->psi = psi;
   q->c = m->c_r + (m->c_p - m->c_r) * e;
   q->dc = (m->c_p - m->c_r) * de;
   q->dphi = (m->phi_p - m->phi_r) * de;
   const double dpsi = (m->psi_p - m->psi_r) * de;
-  q->sf = sin(phi);
-  q->cf = cos(phi);
-  q->ss = sin(psi);
-  q->cs = cos(psi);
+  if (ref) {
+    sin_cos_near(phi, ref->phi, ref->sf, ref->cf, &q->sf, &q->cf);
+    sin_cos_near(psi, ref->psi, ref->ss, ref->cs, &q->ss, &q->cs);
+  } else {
+    q->sf = sin(phi);
+    q->cf = cos(phi);
+    q->ss = sin(psi);
+    q->cs = cos(psi);
+  }
   q->dsf = q->cf * q->dphi;
   q->dcf = -q->sf * q->dphi;
   q->dss = q->cs * dpsi;
@@ -102,19 +127,21 @@ static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q) {
   if (m->surface == MPMC_MC_MOHR_COULOMB) {
     q->eta = q->xi = q->etab = q->deta = q->dxi = q->detab = 0.0;
     if (q->sf > 0.0) {
-      apex = q->c * q->cf / q->sf;
-      dapex = q->dc * q->cf / q->sf - q->c * q->dphi / (q->sf * q->sf);
+      const double isf = 1.0 / q->sf;
+      apex = q->c * q->cf * isf;
+      dapex = q->dc * q->cf * isf - q->c * q->dphi * (isf * isf);
     }
   } else {
     double dpe, dpx, dpb, unused;
-    dp_coef(m->surface, phi, &q->eta, &q->xi, &dpe, &dpx);
-    dp_coef(m->surface, psi, &q->etab, &unused, &dpb, &unused);
+    dp_coef(m->surface, q->sf, q->cf, &q->eta, &q->xi, &dpe, &dpx);
+    dp_coef(m->surface, q->ss, q->cs, &q->etab, &unused, &dpb, &unused);
     q->deta = dpe * q->dphi;
     q->dxi = dpx * q->dphi;
     q->detab = dpb * dpsi;
     if (q->eta > 0.0) {
-      apex = q->xi * q->c / q->eta;
-      dapex = (q->dxi * q->c + q->xi * q->dc) / q->eta - apex * q->deta / q->eta;
+      const double ie = 1.0 / q->eta;
+      apex = q->xi * q->c * ie;
+      dapex = (q->dxi * q->c + q->xi * q->dc) * ie - apex * q->deta * ie;
     }
   }
   if (!(q->st < apex)) { /* also sigma_t = INFINITY with an apex */
@@ -131,7 +158,7 @@ static inline double e_of(const mpmc_mc_param *m, double ep) {
 /* the material of S at eps_p^n + D: the cached one when frozen, else evaluated into *buf */
 static inline const mc_mat *sys_mat(const mc_sys *S, double D, mc_mat *buf) {
   if (S->frozen) return &S->qf;
-  mat_eval(S->m, e_of(S->m, S->ep0 + D), 0, buf);
+  mat_eval(S->m, e_of(S->m, S->ep0 + D), 0, buf, &S->q0);
   return buf;
 }
 
@@ -142,7 +169,7 @@ static inline void sys_freeze(mc_sys *S, double e) {
   if (e == S->e0)
     S->qf = S->q0;
   else
-    mat_eval(S->m, e, 1, &S->qf);
+    mat_eval(S->m, e, 1, &S->qf, &S->q0);
 }
 
 /* De v in principal space */
@@ -150,6 +177,9 @@ static inline void de_mul(const mpmc_mc_param *m, const double v[3], double out[
   const double lam = m->K - 2.0 * m->G / 3.0, tr = v[0] + v[1] + v[2];
   for (int a = 0; a < 3; ++a) out[a] = lam * tr + 2.0 * m->G * v[a];
 }
+
+/* fmax (the larger, a NaN ignored), inlined: libm's is a call on x86-64's baseline */
+static inline double max_nn(double a, double b) { return (a >= b || b != b) ? a : b; }
 
 static inline double dot3(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -295,8 +325,8 @@ static inline void sys_eval(const mc_sys *S, const double *y, double *R,
 /* max of |R_i| / tol over the residuals (R_n in strain: times 2G) */
 static inline double rnorm(const mc_sys *S, const double *R) {
   double r = 0.0;
-  for (int i = 0; i < S->n; ++i) r = fmax(r, fabs(R[i]));
-  r = fmax(r, 2.0 * S->m->G * fabs(R[S->n]));
+  for (int i = 0; i < S->n; ++i) r = max_nn(r, fabs(R[i]));
+  r = max_nn(r, 2.0 * S->m->G * fabs(R[S->n]));
   return isfinite(r) ? r / S->tolf : INFINITY;
 }
 
@@ -620,6 +650,109 @@ static int admissible(const mc_sys *S, const double *y, const double s[3], const
   return 1;
 }
 
+/* The first region alone -- Mohr-Coulomb's main plane (S_A) or Drucker-Prager's cone (S_DP),
+ * where most plastic points return -- with residuals and Jacobian written out for its one
+ * multiplier (eval_planes and eval_dp for n = 1): R (2), J (may be NULL) and the stress s
+ * at y with the material q. */
+static void single_eval(const mc_sys *S, const mc_mat *q, const double *y, double R[2],
+                        double J[2][2], double s[3]) {
+  const mpmc_mc_param *m = S->m;
+  const double c23 = sqrt(2.0 / 3.0), g = y[0];
+  if (S->dp) { /* eval_dp's cone alone */
+    const double *x = S->str;
+    const double px = (x[0] + x[1] + x[2]) / 3.0;
+    const double sx[3] = {x[0] - px, x[1] - px, x[2] - px};
+    const double rj = sqrt(0.5 * dot3(sx, sx));
+    const double ratio = rj > 0.0 ? 1.0 - m->G * g / rj : 0.0;
+    const double p = px - m->K * q->etab * g;
+    for (int i = 0; i < 3; ++i) s[i] = p + ratio * sx[i];
+    R[0] = rj - m->G * g + q->eta * p - q->xi * q->c;
+    double u[3];
+    for (int i = 0; i < 3; ++i) u[i] = rj > 0.0 ? g * sx[i] / (2.0 * rj) : 0.0;
+    R[1] = y[1] - c23 * sqrt(dot3(u, u));
+    if (!J) return;
+    J[0][0] = -m->G - m->K * q->eta * q->etab;
+    J[0][1] = q->deta * p - q->eta * m->K * q->detab * g - q->dxi * q->c - q->xi * q->dc;
+    J[1][0] = (g >= 0.0 ? -1.0 : 1.0) / sqrt(3.0);
+    J[1][1] = 1.0;
+    return;
+  }
+  /* eval_planes' main plane: a = (1 + sf, 0, -(1 - sf)), N = (1 + ss, 0, -(1 - ss)) */
+  const double lam = m->K - 2.0 * m->G / 3.0, G2 = 2.0 * m->G;
+  const double a0 = 1.0 + q->sf, a2 = -(1.0 - q->sf), N0 = 1.0 + q->ss, N2 = -(1.0 - q->ss);
+  const double M0 = g * N0, M2 = g * N2, trM = M0 + M2;
+  s[0] = S->str[0] - (lam * trM + G2 * M0);
+  s[1] = S->str[1] - lam * trM;
+  s[2] = S->str[2] - (lam * trM + G2 * M2);
+  R[0] = a0 * s[0] + a2 * s[2] - 2.0 * q->c * q->cf;
+  const double t3 = trM / 3.0;
+  double u[3] = {M0 - t3, -t3, M2 - t3};
+  const double nd = sqrt(dot3(u, u));
+  R[1] = y[1] - c23 * nd;
+  if (!J) return;
+  for (int i = 0; i < 3; ++i) u[i] = nd > 0.0 ? u[i] / nd : 0.0;
+  const double trN = N0 + N2, dM = g * q->dss; /* dM = (dM, 0, dM) */
+  J[0][0] = -(a0 * (lam * trN + G2 * N0) + a2 * (lam * trN + G2 * N2));
+  J[1][0] = -c23 * (u[0] * N0 + u[2] * N2);
+  const double DdM0 = lam * 2.0 * dM + G2 * dM; /* De dM, components 0 and 2 */
+  J[0][1] = q->dsf * (s[0] + s[2]) - 2.0 * (q->dc * q->cf + q->c * q->dcf) - (a0 + a2) * DdM0;
+  J[1][1] = 1.0 - c23 * (u[0] + u[2]) * dM;
+}
+
+/* solve_region and admissible for the first region alone, with newton's strict rules (its
+ * checks, in the same order) and solve_frozen's predictor.  Returns 0 with y, the stress s,
+ * the material q there and R0 = f when the region holds; 1 when its solution is not
+ * admissible; 2 when Newton gave up (the general loop then tries it again, with KINSOL). */
+static int single_solve(const mc_sys *S, int perfect, double *y, double s[3], mc_mat *q,
+                        double *R0, mpmc_mc_info *info) {
+  double R[2], J[2][2];
+  const int iters0 = info->newton_iters;
+  /* the perfect-plasticity predictor at eps_p^n: R_0 is linear in the multiplier */
+  const double yz[2] = {0.0, 0.0};
+  single_eval(S, &S->q0, yz, R, J, s);
+  y[0] = -R[0] / J[0][0];
+  y[1] = 0.0;
+  if (!(J[0][0] != 0.0) || !isfinite(y[0])) {
+    if (perfect) return 2;
+    y[0] = 0.0;
+  } else {
+    single_eval(S, &S->q0, y, R, NULL, s);
+    y[1] = -R[1];
+  }
+  if (perfect) {
+    *q = S->q0;
+    single_eval(S, q, y, R, NULL, s);
+    if (!(max_nn(fabs(R[0]), 2.0 * S->m->G * fabs(R[1])) <= S->tolf)) return 2;
+  } else {
+    double prev = INFINITY;
+    int ok = 0;
+    for (int it = 0; it < MC_MAX_ITERS && !ok; ++it) {
+      mat_eval(S->m, e_of(S->m, S->ep0 + y[1]), 0, q, &S->q0);
+      single_eval(S, q, y, R, J, s);
+      const double nr = rnorm(S, R);
+      if (nr <= 1.0) {
+        ok = 1;
+        break;
+      }
+      if (!isfinite(nr) || (it >= 3 && nr > 0.5 * prev)) break;
+      const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+      if (!(det != 0.0) || !isfinite(det) || det * J[0][0] <= 0.0) break;
+      info->newton_iters++;
+      y[0] += (-R[0] * J[1][1] + R[1] * J[0][1]) / det;
+      y[1] += (-R[1] * J[0][0] + R[0] * J[1][0]) / det;
+      prev = nr;
+    }
+    if (!ok) {
+      info->newton_iters = iters0;
+      return 2;
+    }
+    /* the derivatives are not needed any more: q as the frozen material there */
+    q->dc = q->dphi = q->dsf = q->dcf = q->dss = q->deta = q->dxi = q->detab = q->dst = 0.0;
+  }
+  *R0 = R[0];
+  return admissible(S, y, s, q) ? 0 : 1;
+}
+
 typedef struct {
   int n, act[3], region;
 } mc_region;
@@ -671,10 +804,14 @@ void mpmc_mc_soften(const mpmc_mc_param *m, double eps_p, double *c, double *phi
  * of |tau_trial|).
  */
 double mpmc_mc_tolerance(const mpmc_mc_param *m, const double t[3]) {
-  double s = fmax(fmax(fabs(t[0]), fabs(t[1])), fmax(fabs(t[2]), m->c_p));
-  if (isfinite(m->sigma_t)) s = fmax(s, fabs(m->sigma_t));
+  double s = max_nn(max_nn(fabs(t[0]), fabs(t[1])), max_nn(fabs(t[2]), m->c_p));
+  if (isfinite(m->sigma_t)) s = max_nn(s, fabs(m->sigma_t));
   return 1e-12 * s + DBL_MIN;
 }
+
+static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double eps_tr[3],
+                     double *eps_p, double eps[3], double tau[3], mpmc_mc_info *info,
+                     const mc_mat *q0in);
 
 /**
  * @brief Frictional return map of one point in principal space (return_mc.h).
@@ -699,6 +836,14 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
   memset(info, 0, sizeof *info);
   if (!m || !eps_tr || !eps_p || !eps || !tau) return MPMC_ERR_ARG;
   if (!param_ok(m)) return MPMC_ERR_ARG;
+  return principal(ws, solver, m, eps_tr, eps_p, eps, tau, info, NULL);
+}
+
+/* mpmc_mc_return_principal for a material that passed param_ok, info zeroed; q0in: the
+ * material at *eps_p when the caller has it (mpmc_mc_update), else NULL. */
+static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double eps_tr[3],
+                     double *eps_p, double eps[3], double tau[3], mpmc_mc_info *info,
+                     const mc_mat *q0in) {
   if (!(isfinite(eps_tr[0]) && isfinite(eps_tr[1]) && isfinite(eps_tr[2]) && isfinite(*eps_p) &&
         *eps_p >= 0))
     return MPMC_ERR_NUMERIC;
@@ -712,13 +857,21 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
         perm[j + 1] = t;
       }
   const double tr = eps_tr[0] + eps_tr[1] + eps_tr[2];
-  mc_sys S = {.m = m, .dp = m->surface != MPMC_MC_MOHR_COULOMB, .ep0 = *eps_p};
+  mc_sys S; /* not zeroed as a whole: ~0.5 kB, a tenth of a fast return */
+  S.m = m;
+  S.dp = m->surface != MPMC_MC_MOHR_COULOMB;
+  S.n = S.act[0] = S.act[1] = S.act[2] = S.frozen = 0;
+  S.ep0 = *eps_p;
+  S.e_frozen = 0.0;
   for (int k = 0; k < 3; ++k) S.str[k] = m->K * tr + 2.0 * m->G * (eps_tr[perm[k]] - tr / 3.0);
   if (!(isfinite(S.str[0]) && isfinite(S.str[2]))) return MPMC_ERR_NUMERIC;
   S.tolf = mpmc_mc_tolerance(m, S.str);
-  S.yscale = fmax(fabs(S.str[0]), fabs(S.str[2])) / m->G + 1e-300;
+  S.yscale = max_nn(fabs(S.str[0]), fabs(S.str[2])) / m->G + 1e-300;
   S.e0 = e_of(m, S.ep0);
-  mat_eval(m, S.e0, 1, &S.q0);
+  if (q0in)
+    S.q0 = *q0in;
+  else
+    mat_eval(m, S.e0, 1, &S.q0, NULL);
   const mc_mat q0 = S.q0;
   const double f0 = S.dp ? dp_f(&q0, S.str) : mc_f(&q0, S.str, 0, 2);
   double s[3], ep_new = S.ep0;
@@ -736,8 +889,25 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
   const int nreg = S.dp ? (int)(sizeof dp_regions / sizeof dp_regions[0])
                         : (int)(sizeof mc_regions / sizeof mc_regions[0]);
   const int tension = isfinite(q0.st) || isfinite(m->sigma_t);
-  int found = 0;
-  for (int r = 0; r < nreg && !found; ++r) {
+  int found = 0, r0 = 0;
+  if (perfect || solver == MPMC_SOLVER_AUTO) { /* the first region in closed form */
+    double y[MC_NMAX] = {0, 0, 0, 0}, R0;
+    mc_mat q;
+    S.n = 1;
+    S.act[0] = regs[0].act[0];
+    const int fs = single_solve(&S, perfect, y, s, &q, &R0, info);
+    if (fs == 0) {
+      found = 1;
+      info->region = regs[0].region;
+      info->dgamma = y[0];
+      info->residual = fabs(R0);
+      ep_new = S.ep0 + y[1];
+      if (q.st_apex && s[0] - s[2] <= 8.0 * S.tolf) info->region = MPMC_MC_APEX;
+    } else if (fs == 1) {
+      r0 = 1; /* converged but not admissible: the general loop from the next region */
+    }
+  }
+  for (int r = r0; r < nreg && !found; ++r) {
     int uses_t = 0;
     for (int j = 0; j < regs[r].n; ++j) uses_t |= regs[r].act[j] >= S_T1 && regs[r].act[j] <= S_T3;
     if (uses_t && !tension) continue;
@@ -748,11 +918,13 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
     const int fail = solve_region(ws, solver, &S, perfect, y, info, &err);
     if (err) return err;
     if (fail) continue;
+    mc_mat q = S.q0; /* the material at the solution, and the stress and residuals there */
+    if (!perfect) mat_eval(m, e_of(m, S.ep0 + y[S.n]), 1, &q, &S.q0);
     mc_sys Se = S;
-    if (perfect) sys_freeze(&Se, S.e0);
+    Se.frozen = 1;
+    Se.e_frozen = perfect ? S.e0 : e_of(m, S.ep0 + y[S.n]);
+    Se.qf = q;
     sys_eval(&Se, y, R, NULL, s);
-    mc_mat q = S.q0;
-    if (!perfect) mat_eval(m, e_of(m, S.ep0 + y[S.n]), 1, &q);
     if (!admissible(&S, y, s, &q)) continue;
     found = 1;
     info->region = regs[r].region;
@@ -773,7 +945,7 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
     const double dv[3] = {S.str[0] - p, S.str[1] - p, S.str[2] - p};
     const double D = sqrt(2.0 / 3.0) * sqrt(dot3(dv, dv)) / (2.0 * m->G);
     mc_mat q = S.q0;
-    if (!perfect) mat_eval(m, e_of(m, S.ep0 + D), 1, &q);
+    if (!perfect) mat_eval(m, e_of(m, S.ep0 + D), 1, &q, &S.q0);
     /* the volume must shrink back (the apex is reached by a volumetric plastic expansion) */
     if (!isfinite(q.st) || !(p >= q.st - S.tolf)) return MPMC_ERR_SOLVER;
     s[0] = s[1] = s[2] = q.st;
@@ -797,9 +969,12 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
  * the series, whose eigen-decomposition gives the principal strains without three logs. */
 static int return_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double *b,
                       int lg, double *be, double *eps_p, double *tau, double *J_out,
-                      mpmc_mc_info *info) {
+                      mpmc_mc_info *info, const mc_mat *q0) {
   double lam[3], Q[3][3], etr[3], e[3], t[3];
-  mpmc_sym3_eig(b, lam, Q);
+  if (lg) /* the update's plastic points: closed form (the Jacobi sweeps cost ~5x the return) */
+    mpmc_sym3_eig_closed(b, lam, Q);
+  else /* the reference path of mpmc_mc_return_map_eig, and strains beyond the series */
+    mpmc_sym3_eig(b, lam, Q);
   for (int a = 0; a < 3; ++a) {
     if (lg) {
       etr[a] = lam[a];
@@ -809,7 +984,14 @@ static int return_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const 
     etr[a] = 0.5 * log(lam[a]);
   }
   double ep = *eps_p;
-  MPMC_CALL(mpmc_mc_return_principal(ws, solver, m, etr, &ep, e, t, info));
+  if (q0) { /* mpmc_mc_update: m passed param_ok, q0 the material at eps_p */
+    mpmc_mc_info local;
+    if (!info) info = &local;
+    memset(info, 0, sizeof *info);
+    MPMC_CALL(principal(ws, solver, m, etr, &ep, e, t, info, q0));
+  } else {
+    MPMC_CALL(mpmc_mc_return_principal(ws, solver, m, etr, &ep, e, t, info));
+  }
   for (int a = 0; a < 3; ++a) lam[a] = exp(2.0 * e[a]);
   mpmc_sym3_compose(lam, Q, be);
   mpmc_sym3_compose(t, Q, tau);
@@ -834,7 +1016,7 @@ int mpmc_mc_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, d
   double b[6];
   for (int k = 0; k < 6; ++k) b[k] = be[k];
   if (F) mpmc_push_forward(F, b);
-  return return_eig(ws, solver, m, b, 0, be, eps_p, tau, J_out, info);
+  return return_eig(ws, solver, m, b, 0, be, eps_p, tau, J_out, info, NULL);
 }
 
 /**
@@ -846,12 +1028,13 @@ void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre) {
   pre->valid = param_ok(m);
   pre->perfect = m->eta == 0.0 || (m->c_p == m->c_r && m->phi_p == m->phi_r && m->psi_p == m->psi_r);
   mc_mat q;
-  mat_eval(m, e_of(m, 0.0), 1, &q);
+  mat_eval(m, e_of(m, 0.0), 1, &q, NULL);
   pre->sf = q.sf;
   pre->k = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
   pre->eta = q.eta;
   pre->gmax = sqrt(1.0 + q.sf * q.sf / 3.0);
   pre->st = q.st;
+  pre->q0 = q;
 }
 
 /* The elastic check of the trial b without eigenvectors.  Hencky strain eps by the series,
@@ -868,7 +1051,7 @@ void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre) {
  * written; 0 leaves the point to the eigen path (plastic, near a surface, or |eps| >~ 0.18),
  * with eps in *eps_out (and 1 in *lg) when the series gave it. */
 static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, double *eps_out,
-                        int *lg, double *be, double *tau, double *J_out) {
+                        int *lg, double *be, double *tau, double *J_out, mc_mat *qout) {
   const mpmc_mc_param *m = &pre->m;
   double e[6];
   *lg = 0;
@@ -881,9 +1064,11 @@ static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, d
   for (int k = 0; k < 6; ++k) s[k] = G2 * e[k];
   const double j2 = 0.5 * mpmc_sym3_norm2(s), rj = sqrt(j2);
   double sf = pre->sf, k = pre->k, eta = pre->eta, gmax = pre->gmax, st = pre->st;
+  *qout = pre->q0;
   if (!(pre->perfect || eps_p == 0.0)) {
     mc_mat q;
-    mat_eval(m, e_of(m, eps_p), 1, &q);
+    mat_eval(m, e_of(m, eps_p), 1, &q, NULL);
+    *qout = q;
     sf = q.sf;
     k = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
     eta = q.eta;
@@ -899,7 +1084,7 @@ static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, d
   if (!(ok_f && ok_t)) {
     /* the largest and smallest principal deviatoric stresses from the invariants */
     const double x = j2 > 0.0 ? 1.5 * r3 * mpmc_det_sym(s) / (j2 * rj) : 1.0;
-    const double a = acos(fmin(1.0, fmax(-1.0, x))) / 3.0, ca = cos(a), sa = sin(a);
+    const double a = acos(!(x > -1.0) ? -1.0 : x >= 1.0 ? 1.0 : x) / 3.0, ca = cos(a), sa = sin(a);
     const double R = 2.0 * rj / r3, s1 = R * ca, s3 = R * (-0.5 * ca - 0.5 * r3 * sa);
     if (!ok_f) ok_f = (s1 - s3) + (2.0 * p + s1 + s3) * sf - k < -margin;
     if (!ok_t) ok_t = p + s1 < st - margin;
@@ -912,6 +1097,64 @@ static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, d
   return 1;
 }
 
+/* Drucker-Prager's plastic point without eigenvectors (as J2's, material_hencky_j2.c).  The
+ * cone's return is radial in the deviator: its principal problem sees the trial stress only
+ * through p and J2 (eval_dp), so the principal values from the invariants (elastic_fast's
+ * trigonometric form, ~1e-8 off near repeated values but with p and J2 to round-off) give
+ * the eigen path's multipliers and eps_p.  Then, with dev(tau) = ratio dev(tau_trial),
+ *   tau = p I + ratio 2G dev(eps),  b_e = exp(2 eps_new) = b exp(2 (ratio - 1) dev(eps))
+ *   exp(2 (tr eps_new - tr eps) / 3)
+ * (b and the correction commute).  Only a return to the cone (region 1) or to the
+ * hydrostatic point (s1 = s2 = s3) whose largest principal stress stays 1e-6 of the stress
+ * scale clear of the cut-off is taken here (the trigonometric s1 decides nothing else);
+ * returns 1 with nothing written for the rest, which take the eigen path. */
+static int dp_radial(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, const double *b,
+                     const double *eps, const mc_mat *q0, double *be, double *eps_p,
+                     double *tau, double *J_out, mpmc_mc_info *info) {
+  const mpmc_mc_param *m = &pre->m;
+  const double tr = eps[0] + eps[1] + eps[2], r3 = 1.7320508075688772;
+  double e[6];
+  for (int k = 0; k < 6; ++k) e[k] = eps[k];
+  for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
+  const double j2 = 0.5 * mpmc_sym3_norm2(e), rj = sqrt(j2); /* of dev eps */
+  if (!(rj > 0.0)) return 1;
+  const double x = 1.5 * r3 * mpmc_det_sym(e) / (j2 * rj);
+  const double a = acos(!(x > -1.0) ? -1.0 : x >= 1.0 ? 1.0 : x) / 3.0, ca = cos(a), sa = sin(a);
+  const double R = 2.0 * rj / r3;
+  const double etr[3] = {tr / 3.0 + R * ca, tr / 3.0 + R * (-0.5 * ca + 0.5 * r3 * sa),
+                         tr / 3.0 + R * (-0.5 * ca - 0.5 * r3 * sa)};
+  double ep = *eps_p, en[3], t[3];
+  mpmc_mc_info loc = {0};
+  if (principal(ws, solver, m, etr, &ep, en, t, &loc, q0)) return 1;
+  const double pn = (t[0] + t[1] + t[2]) / 3.0, sc = fabs(t[0]) + fabs(t[2]) + m->c_p;
+  double st = q0->st, ratio;
+  if (!(pre->perfect || ep == *eps_p)) {
+    mc_mat q;
+    mat_eval(m, e_of(m, ep), 1, &q, q0);
+    st = q.st;
+  }
+  const int k = fabs(etr[2] - tr / 3.0) > fabs(etr[0] - tr / 3.0) ? 2 : 0; /* largest |dev| */
+  if (loc.region == MPMC_MC_PLANE && t[0] < st - 1e-6 * sc)
+    ratio = (t[k] - pn) / (2.0 * m->G * (etr[k] - tr / 3.0));
+  else if (loc.region == MPMC_MC_APEX && t[0] == t[1] && t[1] == t[2])
+    ratio = 0.0;
+  else
+    return 1;
+  const double trn = en[0] + en[1] + en[2];
+  double c[6], E[6];
+  for (int k = 0; k < 6; ++k) c[k] = 2.0 * (ratio - 1.0) * e[k];
+  if (mpmc_sym3_exp_series(c, E)) return 1;
+  mpmc_sym3_mul(b, E, be);
+  const double fv = exp(2.0 * (trn - tr) / 3.0);
+  for (int k = 0; k < 6; ++k) be[k] *= fv;
+  for (int k = 0; k < 6; ++k) tau[k] = 2.0 * m->G * ratio * e[k];
+  for (int k = 0; k < 3; ++k) tau[k] += pn;
+  if (J_out) *J_out = exp(trn);
+  *eps_p = ep;
+  if (info) *info = loc;
+  return 0;
+}
+
 /**
  * @brief The frictional return map of one point in tensor form (return_mc.h): the elastic
  * check without eigenvectors (elastic_fast), the eigen path for the rest.
@@ -922,14 +1165,20 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
                    double *be, double *eps_p, double *tau, double *J_out, mpmc_mc_info *info) {
   double b[6], eps[6];
   int lg = 0;
+  mc_mat q0;
   for (int k = 0; k < 6; ++k) b[k] = be[k];
   if (F) mpmc_push_forward(F, b);
   if (pre->valid && *eps_p >= 0.0 && isfinite(*eps_p) &&
-      elastic_fast(pre, b, *eps_p, eps, &lg, be, tau, J_out)) {
+      elastic_fast(pre, b, *eps_p, eps, &lg, be, tau, J_out, &q0)) {
     if (info) memset(info, 0, sizeof *info);
     return MPMC_SUCCESS;
   }
-  return return_eig(ws, solver, &pre->m, lg ? eps : b, lg, be, eps_p, tau, J_out, info);
+  /* lg: the series gave eps and elastic_fast the material at eps_p */
+  if (lg && pre->m.surface != MPMC_MC_MOHR_COULOMB &&
+      !dp_radial(ws, solver, pre, b, eps, &q0, be, eps_p, tau, J_out, info))
+    return MPMC_SUCCESS;
+  return return_eig(ws, solver, &pre->m, lg ? eps : b, lg, be, eps_p, tau, J_out, info,
+                    lg ? &q0 : NULL);
 }
 
 /**

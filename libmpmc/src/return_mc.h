@@ -103,6 +103,18 @@ int mpmc_mc_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, d
                            double *be, double *eps_p, double *tau, double *J_out,
                            mpmc_mc_info *info);
 
+/* The material at one eps_p, its derivatives in eps_p and what its surfaces need (private
+ * to return_mc.c; here for mpmc_mc_pre). */
+typedef struct {
+  double phi, psi;                /* the angles (the reference of nearby evaluations)     */
+  double c, sf, cf, ss, cs;       /* c, sin/cos phi, sin/cos psi                          */
+  double dc, dphi, dsf, dcf, dss; /* d/d eps_p                                            */
+  double eta, xi, etab;           /* Drucker-Prager: eta_f(phi), xi(phi), eta_f(psi)      */
+  double deta, dxi, detab;
+  double st, dst;                 /* cut-off, capped at the apex                          */
+  int st_apex;                    /* 1 when the cap (the apex) is the cut-off              */
+} mpmc_mc_mat;
+
 /* What the elastic check of a point needs, worked out once per material (sines, cosines,
  * the cut-off's cap) for the points that have not yielded (eps_p = 0, most of a slope) and
  * for every point under perfect plasticity: mpmc_mc_prepare, then mpmc_mc_update per point. */
@@ -117,6 +129,7 @@ typedef struct {
   double gmax; /* Mohr-Coulomb: sqrt(1 + sin^2(phi_p) / 3), the largest (s1 - s3 - s2 sin
                   phi) / (2 sqrt(J2)) over the Lode angle                                */
   double st;   /* the cut-off at the peak, capped at the apex (INFINITY: none)          */
+  mpmc_mc_mat q0; /* the material at eps_p = 0 (every eps_p under perfect plasticity)    */
 } mpmc_mc_pre;
 
 void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre);
