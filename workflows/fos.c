@@ -9,11 +9,24 @@
  * (a slope that keeps moving has not found equilibrium; a stable one settles, its d
  * converging).  The first
  * bracket is widened (lo / 1.5, hi x 1.5) until lo stands and hi fails, then bisected until
- * hi - lo <= tolerance.  The factor of safety reported is the bracket's midpoint. */
+ * hi - lo <= tolerance.  The factor of safety reported is the bracket's midpoint.
+ *
+ * Concurrent trials (`jobs: k`): each round runs k trials at once, each in a child process
+ * (fork) that opens fos_base.h5 itself, runs its trial exactly as a search with one job does
+ * (same factor, same bits), writes its wf_fos_trial into a pipe and leaves with _exit; the
+ * parent reports the round's trials in factor order.  A round places its k factors evenly
+ * inside the bracket (k = 1: bisection; k = 2: trisection), the first evaluates lo and hi
+ * together.  No HDF5 file is open in the parent at a fork (snapshots and checkpoints open and
+ * close theirs per write), and the child never returns into the parent's code. */
+#include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "wf.h"
 
@@ -113,12 +126,112 @@ static int run_trial(mpmc_context ctx, const char *base, const wf_scene *sc, con
   return e;
 }
 
+/* What a child process sends back through its pipe: the trial, or the error that stopped it */
+typedef struct {
+  wf_fos_trial t;
+  int e;
+  char msg[1024];
+} trial_report;
+
+/* read exactly n bytes (fewer: the writer ended first) */
+static size_t read_all(int fd, void *buf, size_t n) {
+  size_t got = 0;
+  while (got < n) {
+    const ssize_t r = read(fd, (char *)buf + got, n - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) break;
+    got += (size_t)r;
+  }
+  return got;
+}
+
+/* The k trials F[0..k) into t[0..k): in this process when k = 1, else at once in k child
+ * processes.  0, or the first error (by factor) with msg naming the factor. */
+static int run_round(mpmc_context ctx, const char *base, const wf_scene *sc, const wf_stage *s, const double *F,
+                     int k, wf_fos_trial *t, char *msg, size_t len) {
+  if (k == 1) return run_trial(ctx, base, sc, s, F[0], &t[0], msg, len);
+  pid_t pid[WF_FOS_MAX_JOBS];
+  int fd[WF_FOS_MAX_JOBS], started = 0, e = 0;
+  fflush(NULL); /* nothing buffered twice (a child leaves by _exit, which does not flush) */
+  for (int j = 0; j < k; ++j) {
+    int p[2];
+    if (pipe(p)) {
+      e = MPMC_ERR_IO;
+      snprintf(msg, len, "trial F = %g: cannot create a pipe: %s", F[j], strerror(errno));
+      break;
+    }
+    const pid_t c = fork();
+    if (c < 0) {
+      e = MPMC_ERR_IO;
+      snprintf(msg, len, "trial F = %g: cannot start its process: %s", F[j], strerror(errno));
+      close(p[0]);
+      close(p[1]);
+      break;
+    }
+    if (c == 0) {
+      /* the child: its own trial from fos_base.h5, the report, _exit (no atexit handlers:
+       * the parent's HDF5 library state and stdio buffers are the parent's to close) */
+      close(p[0]);
+      for (int i = 0; i < started; ++i) close(fd[i]);
+      trial_report r;
+      memset(&r, 0, sizeof r);
+      r.e = run_trial(ctx, base, sc, s, F[j], &r.t, r.msg, sizeof r.msg);
+      const char *b = (const char *)&r;
+      size_t left = sizeof r;
+      while (left > 0) {
+        const ssize_t w = write(p[1], b, left);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) _exit(2);
+        b += w;
+        left -= (size_t)w;
+      }
+      _exit(0);
+    }
+    close(p[1]);
+    pid[started] = c;
+    fd[started++] = p[0];
+  }
+  /* every child started is read and waited for, also after an error */
+  for (int j = 0; j < started; ++j) {
+    trial_report r;
+    const size_t got = read_all(fd[j], &r, sizeof r);
+    close(fd[j]);
+    int st = 0;
+    while (waitpid(pid[j], &st, 0) < 0 && errno == EINTR) {
+    }
+    if (e) continue;
+    if (got != sizeof r || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+      e = MPMC_ERR_IO;
+      if (WIFSIGNALED(st))
+        snprintf(msg, len, "trial F = %g: its process (pid %ld) died of signal %d (%s)", F[j], (long)pid[j],
+                 WTERMSIG(st), strsignal(WTERMSIG(st)));
+      else
+        snprintf(msg, len, "trial F = %g: its process (pid %ld) ended (exit status %d) without its result", F[j],
+                 (long)pid[j], WIFEXITED(st) ? WEXITSTATUS(st) : -1);
+    } else if (r.e) {
+      e = r.e;
+      r.msg[sizeof r.msg - 1] = '\0';
+      snprintf(msg, len, "%s", r.msg);
+    } else {
+      t[j] = r.t;
+    }
+  }
+  return e;
+}
+
 int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage, const char *outdir,
                   wf_fos_result *res, void (*say)(void *data, const char *line), void *data, char *msg,
                   size_t len) {
   const wf_stage *s = &sc->stages[stage];
   const wf_fos *f = &s->fos;
+  const int jobs = f->jobs < 1 ? 1 : f->jobs > WF_FOS_MAX_JOBS ? WF_FOS_MAX_JOBS : f->jobs;
   char base[WF_PATH + 32], line[512];
+  if (jobs > 1 && sc->threads != 1) {
+    /* OpenMP's thread pool does not survive a fork; one thread per trial process anyway */
+    snprintf(msg, len, "factor_of_safety.jobs = %d runs trials in processes of one thread each: set threads: 1 "
+                       "(got %d)", jobs, sc->threads);
+    return MPMC_ERR_ARG;
+  }
   snprintf(base, sizeof base, "%s/fos_base.h5", outdir);
   int e = mpmc_sim_checkpoint_write(sim, base, "mpmc-workflow fos base");
   if (e) {
@@ -126,46 +239,64 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
     return e;
   }
   memset(res, 0, sizeof *res);
+  res->jobs = jobs;
   double lo = f->lo, hi = f->hi;
   int lo_ok = 0, hi_ok = 0; /* lo known to stand, hi known to fail */
-  while (res->ntrial < f->max_trials) {
-    double F;
-    if (!lo_ok)
-      F = lo;
-    else if (!hi_ok)
-      F = hi;
-    else if (hi - lo > f->tolerance)
-      F = 0.5 * (lo + hi);
-    else
+  for (;;) {
+    double F[WF_FOS_MAX_JOBS];
+    int k = 0;
+    const int room = f->max_trials - res->ntrial, bracketing = !lo_ok || !hi_ok;
+    if (room <= 0) break;
+    if (bracketing) {
+      if (!lo_ok) F[k++] = lo;
+      if (!hi_ok && (k == 0 || (jobs > 1 && room > 1))) F[k++] = hi;
+    } else if (hi - lo > f->tolerance) {
+      /* k evenly inside the bracket: as many as the jobs, or fewer when they reach the tolerance */
+      k = jobs < room ? jobs : room;
+      for (int m = 1; m < k; ++m)
+        if ((hi - lo) / (m + 1) <= f->tolerance) {
+          k = m;
+          break;
+        }
+      for (int j = 0; j < k; ++j) F[j] = k == 1 ? 0.5 * (lo + hi) : lo + (hi - lo) * (j + 1) / (k + 1);
+    } else {
       break;
+    }
     wf_fos_trial *t = &res->trial[res->ntrial];
-    e = run_trial(ctx, base, sc, s, F, t, msg, len);
+    const int first = res->ntrial + 1;
+    e = run_round(ctx, base, sc, s, F, k, t, msg, len);
     if (e) return e;
-    res->ntrial++;
-    snprintf(line, sizeof line,
-             "factor of safety: trial %d, F = %.4f: %s (largest displacement %.4g m, limit %g m; grew %.3g "
-             "of it over the last quarter, limit %g; E_k/E_k,max %.3g; %ld steps, %.1f s)",
-             res->ntrial, F, t->failed ? "fails" : "stands", t->max_displacement, f->displacement_limit,
-             t->growth, f->growth, t->ke_ratio, t->steps, t->wall_seconds);
-    if (say) say(data, line);
-    if (!lo_ok) {
-      if (t->failed) {
+    for (int j = 0; j < k; ++j) {
+      snprintf(line, sizeof line,
+               "factor of safety: trial %d, F = %.4f: %s (largest displacement %.4g m, limit %g m; grew %.3g "
+               "of it over the last quarter, limit %g; E_k/E_k,max %.3g; %ld steps, %.1f s)",
+               first + j, F[j], t[j].failed ? "fails" : "stands", t[j].max_displacement, f->displacement_limit,
+               t[j].growth, f->growth, t[j].ke_ratio, t[j].steps, t[j].wall_seconds);
+      if (say) say(data, line);
+    }
+    res->ntrial += k;
+    if (bracketing) {
+      const wf_fos_trial *tl = !lo_ok ? &t[0] : NULL, *th = !hi_ok && k > (tl != NULL) ? &t[k - 1] : NULL;
+      if (tl && tl->failed) {
         hi = lo, hi_ok = 1; /* the lower guess fails: it bounds from above, look lower */
         lo = lo / 1.5;
       } else {
-        lo_ok = 1;
+        if (tl) lo_ok = 1;
+        if (th && th->failed) {
+          hi_ok = 1;
+        } else if (th) {
+          lo = hi, lo_ok = 1; /* stands: widen upwards */
+          hi = hi * 1.5;
+        }
       }
-    } else if (!hi_ok) {
-      if (t->failed) {
-        hi_ok = 1;
-      } else {
-        lo = hi; /* stands: widen upwards */
-        hi = hi * 1.5;
-      }
-    } else if (t->failed) {
-      hi = F;
     } else {
-      lo = F;
+      /* the smallest failing factor bounds from above, the largest standing one below it from
+       * below (a standing factor above a failing one is left out) */
+      int jf = k;
+      for (int j = 0; j < k && jf == k; ++j)
+        if (t[j].failed) jf = j;
+      for (int j = 0; j < jf; ++j) lo = F[j];
+      if (jf < k) hi = F[jf];
     }
   }
   res->lo = lo;
@@ -194,7 +325,8 @@ void wf_fos_json(FILE *f, const wf_fos_result *res) {
     fprintf(f, ",\n  \"factor_of_safety\": %.6g", 0.5 * (res->lo + res->hi));
   else
     fputs(",\n  \"factor_of_safety\": null", f);
-  fprintf(f, ",\n  \"fos_bracket\": [%.6g, %.6g],\n  \"fos_trials\": [", res->lo, res->hi);
+  fprintf(f, ",\n  \"fos_bracket\": [%.6g, %.6g],\n  \"fos_jobs\": %d,\n  \"fos_trials\": [", res->lo, res->hi,
+          res->jobs);
   for (int i = 0; i < res->ntrial; ++i) {
     const wf_fos_trial *t = &res->trial[i];
     fprintf(f, "%s\n    {\"factor\": %.9g, \"verdict\": \"%s\", \"max_displacement\": %.9g, \"growth\": %.6g, "

@@ -657,8 +657,9 @@ static int run_fos(wf_run *w, int i) {
   snprintf(rec->name, sizeof rec->name, "%s", s->name);
   if (!w->fos && !(w->fos = calloc(1, sizeof *w->fos))) return fail(w, MPMC_ERR_MEMORY, "factor of safety");
   char msg[WF_MSG] = "";
-  say(w, "stage %d/%d %s: factor of safety between %g and %g to %g, trials of %g s, failure beyond %g m",
-      i + 1, w->sc.nstage, s->name, s->fos.lo, s->fos.hi, s->fos.tolerance, s->end_time, s->fos.displacement_limit);
+  say(w, "stage %d/%d %s: factor of safety between %g and %g to %g, trials of %g s, failure beyond %g m, "
+      "%d trial%s at once", i + 1, w->sc.nstage, s->name, s->fos.lo, s->fos.hi, s->fos.tolerance, s->end_time,
+      s->fos.displacement_limit, s->fos.jobs, s->fos.jobs > 1 ? "s (child processes)" : "");
   const int e = wf_fos_search(w->ctx, w->sim, &w->sc, i, w->out, w->fos, w->quiet ? NULL : say_line, w, msg,
                               sizeof msg);
   if (e) return fail(w, e, "stage '%s': %s", s->name, msg);

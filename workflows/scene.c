@@ -971,7 +971,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
                                      "snapshots", "series_points", "rigid_bodies", "force_dt",
                                      "factor_of_safety", NULL};
   static const char *const fos_keys[] = {"lo", "hi", "tolerance", "displacement_limit", "growth", "max_trials",
-                                         NULL};
+                                         "jobs", NULL};
   static const char *const end_keys[] = {"time", "kinetic_energy_ratio", "max_time", "min_time", NULL};
   static const char *const tr_keys[] = {"set", "lo", "hi", "traction", NULL};
   for (int i = 0; i < ss->n; ++i) {
@@ -1065,7 +1065,8 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
           get_num(r, fn, full, "tolerance", 0, 0.01, POS, &f->tolerance) ||
           get_num(r, fn, full, "displacement_limit", 1, 0, POS, &f->displacement_limit) ||
           get_num(r, fn, full, "growth", 0, 0.05, UNIT, &f->growth) ||
-          get_int(r, fn, full, "max_trials", 0, 30, 2, 64, &f->max_trials))
+          get_int(r, fn, full, "max_trials", 0, 30, 2, 64, &f->max_trials) ||
+          get_int(r, fn, full, "jobs", 0, 1, 1, WF_FOS_MAX_JOBS, &f->jobs))
         return -1;
       char hp[600];
       join(hp, sizeof hp, full, "hi");

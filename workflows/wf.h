@@ -111,6 +111,7 @@ typedef struct {
   double growth;             /* ... or when its largest displacement still grows by more
                                 than this fraction over the trial's last quarter        */
   int max_trials;
+  int jobs;                  /* trials at once, each in a child process (1: in this one) */
 } wf_fos;
 typedef struct {
   char name[WF_NAME];
@@ -235,6 +236,7 @@ typedef struct {
 } wf_stage_record;
 
 /* ---- the factor-of-safety search (fos.c) ------------------------------------------ */
+#define WF_FOS_MAX_JOBS 16 /* factor_of_safety.jobs at most */
 typedef struct {
   double factor, max_displacement, growth, ke_ratio, sim_time, wall_seconds;
   long steps;
@@ -245,6 +247,7 @@ typedef struct {
   wf_fos_trial trial[64];
   double lo, hi;             /* the final bracket: lo stood, hi failed                  */
   int found;                 /* 1: bracketed to the tolerance                           */
+  int jobs;                  /* trials run at once                                      */
 } wf_fos_result;
 /* The search of stage s from the state sim (set up for the stage), which it leaves as it is:
  * the state is saved to outdir/fos_base.h5 and every trial starts from it.
