@@ -48,10 +48,6 @@ static mpmc_mc_param frictional_param(const mpmc_material *mat, int surface) {
                          .surface = surface};
 }
 
-static const char *solver_name(int solver) {
-  return solver == MPMC_SOLVER_NEWTON ? "newton" : solver == MPMC_SOLVER_KINSOL ? "kinsol" : "auto";
-}
-
 int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                            int surface) {
   mpmc_particles *p = &sim->p;
@@ -116,6 +112,6 @@ int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int
                     "KINSOL flag %d, J = %g",
                     (long long)sim->stats.steps, sim->time, mat->model->name,
                     mpmc_point_name(p, q, nb), x[0], x[1], d == 3 ? x[2] : 0.0, id,
-                    solver_name(solver), info.region, p->eps_p[q], info.dgamma, info.residual,
+                    mpmc_solver_name(solver), info.region, p->eps_p[q], info.dgamma, info.residual,
                     info.kinsol_flag, Jm[q]);
 }

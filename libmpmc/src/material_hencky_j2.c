@@ -150,10 +150,6 @@ int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, doubl
   return return_map_point(ws, solver, m, F, be, eps_p, tau, J_out, info ? info : &local);
 }
 
-static const char *solver_name(int solver) {
-  return solver == MPMC_SOLVER_NEWTON ? "newton" : solver == MPMC_SOLVER_KINSOL ? "kinsol" : "auto";
-}
-
 static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) {
   (void)dt;
   mpmc_particles *p = &sim->p;
@@ -183,7 +179,7 @@ static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) 
                     "solver %s) failed: trial q = %g, kappa = %g, eps_p = %g, dgamma = %g, "
                     "|g| = %g, KINSOL flag %d",
                     (long long)sim->stats.steps, sim->time, mpmc_point_name(p, q, nb), x[0], x[1],
-                    d == 3 ? x[2] : 0.0, id, solver_name(solver), info.q_trial, info.kappa, p->eps_p[q], info.dgamma,
+                    d == 3 ? x[2] : 0.0, id, mpmc_solver_name(solver), info.q_trial, info.kappa, p->eps_p[q], info.dgamma,
                     info.residual, info.kinsol_flag);
 }
 

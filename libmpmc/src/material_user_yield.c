@@ -15,10 +15,6 @@
 
 extern const mpmc_model mpmc_model_user_yield;
 
-static const char *solver_name(int solver) {
-  return solver == MPMC_SOLVER_NEWTON ? "newton" : solver == MPMC_SOLVER_KINSOL ? "kinsol" : "auto";
-}
-
 static int uy_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
   (void)dt;
   mpmc_particles *p = &sim->p;
@@ -94,7 +90,7 @@ static int uy_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, d
   return MPMC_ERROR(sim->ctx, err,
                     "step %lld, t = %g: user yield surface (material %d, solver %s) failed at "
                     "point %s (%g, %g, %g): %s%s",
-                    (long long)sim->stats.steps, sim->time, id, solver_name(solver),
+                    (long long)sim->stats.steps, sim->time, id, mpmc_solver_name(solver),
                     mpmc_point_name(p, q, nb), x[0], x[1], d == 3 ? x[2] : 0.0,
                     info.message[0] ? info.message : "non-finite stress", deriv);
 }

@@ -385,6 +385,8 @@ typedef struct {
 } mpmc_water_table;
 /* the pore pressure at position x (dim coordinates) */
 double mpmc_water_pressure(const mpmc_water_table *wt, int dim, const double *x);
+/* the name of a local solver for messages (step.c): "auto", "newton", "kinsol" */
+const char *mpmc_solver_name(int solver);
 /* p->pw of every point from its position (each step before the stresses) */
 void mpmc_water_update(struct mpmc_sim_s *sim);
 /* the density of a new point of material m at x: rho_sat below the water table */

@@ -61,6 +61,11 @@ mpmc_stress_batch_fn mpmc_kernels_stress_batch(const struct mpmc_sim_s *sim, int
                                      : KERNELS(sim)->nh_batch;
 }
 
+/* The name of a local solver (mpmc_solver) for messages: "auto", "newton" or "kinsol". */
+const char *mpmc_solver_name(int solver) {
+  return solver == MPMC_SOLVER_NEWTON ? "newton" : solver == MPMC_SOLVER_KINSOL ? "kinsol" : "auto";
+}
+
 /**
  * @brief The name of a step phase (mpmc_phase), a static string.
  */
