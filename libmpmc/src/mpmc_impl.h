@@ -419,6 +419,7 @@ struct mpmc_sim_s {
    * until mpmc_sim_restore_field: both clear it) */
   double v2max;
   int v2max_ok, v_borrowed;
+  struct mpmc_dd_s *dd; /* the MPI decomposition (mpi.c); NULL: one process            */
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),
@@ -531,5 +532,11 @@ int mpmc_contact_check(struct mpmc_sim_s *sim);
 void mpmc_contact_step(struct mpmc_sim_s *sim, int begin);
 /* sets.c */
 void mpmc_sets_free(struct mpmc_sim_s *sim);
+
+/* mpi.c: the MPI decomposition; every function is a no-op (one process) when sim->dd is
+ * NULL, as always in a build without MPI. */
+#define MPMC_DD_MIN_CELLS 5 /* a slab's least width: only two ranks reach a halo node    */
+int mpmc_dd_setup(struct mpmc_sim_s *sim);
+void mpmc_dd_free(struct mpmc_sim_s *sim);
 
 #endif

@@ -120,6 +120,7 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
 int mpmc_sim_destroy(mpmc_sim *sim) {
   if (!sim || !*sim) return MPMC_SUCCESS;
   mpmc_sim s = *sim;
+  mpmc_dd_free(s);
   mpmc_return_map_free(s);
   mpmc_contact_free(s);
   mpmc_sets_free(s);
@@ -161,6 +162,7 @@ int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h
   MPMC_CHECK(!sim->node_sets || sim->node_sets->n == 0, sim->ctx, MPMC_ERR_STATE,
              "the grid must be set before node sets are added");
   MPMC_CALL(mpmc_grid_setup(sim->ctx, &sim->grid, sim->dim, lo, hi, h));
+  MPMC_CALL(mpmc_dd_setup(sim)); /* MPI: the ranks' slabs of this grid */
   sim->prepared = 0;
   sim->walls_dirty = 1;
   return MPMC_SUCCESS;
