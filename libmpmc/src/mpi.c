@@ -50,6 +50,7 @@ void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (v
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) { return (void)sim, (void)v, 1; }
 void mpmc_dd_free(struct mpmc_sim_s *sim) { (void)sim; }
+int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return (void)sim, 1; }
 
 #else /* MPMC_HAVE_MPI */
 
@@ -128,6 +129,8 @@ int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis,
   if (cell_hi) *cell_hi = dd->cut[dd->rank + 1];
   return MPMC_SUCCESS;
 }
+
+int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return sim->dd ? sim->dd->size : 1; }
 
 void mpmc_dd_free(struct mpmc_sim_s *sim) {
   struct mpmc_dd_s *dd = sim->dd;
