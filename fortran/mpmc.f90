@@ -165,6 +165,9 @@ module mpmc
     mpmc_sim_set_kinetic_damping, mpmc_sim_set_solver, mpmc_sim_set_threads, &
     mpmc_sim_set_kernels, mpmc_sim_get_kernels, mpmc_sim_set_water_table, &
     mpmc_sim_set_water_table_plane, mpmc_sim_set_geostatic_stress
+  ! MPI builds only (libmpmc/include/mpmc_mpi.h): comm is MPI's Fortran handle, the integer
+  ! of the mpi module or mpi_f08's comm%MPI_VAL
+  public :: mpmc_sim_create_mpi_f, mpmc_sim_get_mpi_slab
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
@@ -295,6 +298,22 @@ module mpmc
       import :: c_int, mpmc_context, mpmc_sim
       type(mpmc_sim), value :: sim
       type(mpmc_context), intent(out) :: ctx
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_create_mpi_f(ctx, comm, dim, sim) bind(C, name='mpmc_sim_create_mpi_f') &
+        result(ierr)
+      import :: c_int, mpmc_context, mpmc_sim
+      type(mpmc_context), value :: ctx
+      integer(c_int), value :: comm
+      integer(c_int), value :: dim
+      type(mpmc_sim), intent(out) :: sim
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_mpi_slab(sim, rank, nranks, axis, cell_lo, cell_hi) &
+        bind(C, name='mpmc_sim_get_mpi_slab') result(ierr)
+      import :: c_int, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), intent(out) :: rank, nranks, axis, cell_lo, cell_hi
       integer(c_int) :: ierr
     end function
     function mpmc_sim_get_dim(sim, dim) bind(C, name='mpmc_sim_get_dim') result(ierr)

@@ -35,7 +35,7 @@ install(TARGETS ${MPMC_INSTALL_TARGETS} EXPORT mpmcTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(FILES ${PROJECT_SOURCE_DIR}/libmpmc/include/mpmc.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES ${MPMC_LIB_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # the optional libraries' headers, with their libraries
 foreach(t gmsh workflow)
   if(TARGET mpmc_${t})
@@ -61,8 +61,15 @@ install(EXPORT mpmcTargets NAMESPACE mpmc:: DESTINATION ${MPMC_INSTALL_CMAKEDIR}
 
 # mpmcConfig.cmake: the targets, plus a Fortran component that is found only when the
 # Fortran library was built.
+# An MPI build's mpmc links MPI::MPI_C for its users (mpmc_mpi.h includes mpi.h): found first.
+if(MPMC_WITH_MPI)
+  set(MPMC_CONFIG_DEPENDENCIES "include(CMakeFindDependencyMacro)\nfind_dependency(MPI COMPONENTS C)")
+else()
+  set(MPMC_CONFIG_DEPENDENCIES "")
+endif()
 file(WRITE ${PROJECT_BINARY_DIR}/mpmcConfig.cmake.in [=[
 @PACKAGE_INIT@
+@MPMC_CONFIG_DEPENDENCIES@
 include("${CMAKE_CURRENT_LIST_DIR}/mpmcTargets.cmake")
 set(mpmc_Fortran_FOUND @MPMC_HAVE_FORTRAN@)
 set(mpmc_C_FOUND 1)

@@ -4,14 +4,16 @@
 # tests/CMakeLists.txt; run in script mode (cmake -DHEADERS=a.h,b.h -DMODULE=... -P) as the
 # check.  The headers are parsed by libmpmc/public_api.cmake, as for the libraries' exports.
 # t014-exported-symbols: each shared library exports exactly the functions of its public
-# header (libmpmc: mpmc.h, libmpmc_gmsh: mpmc_gmsh.h, libmpmc_workflow: mpmc_workflow.h).
+# header (libmpmc: mpmc.h and, in an MPI build, mpmc_mpi.h; libmpmc_gmsh: mpmc_gmsh.h, libmpmc_workflow: mpmc_workflow.h).
 if(CMAKE_SCRIPT_MODE_FILE)
   cmake_policy(VERSION 3.25) # the project's minimum (IN_LIST)
   # Functions that have no binding of their own, each with the reason:
   #  - mpmc_context_last_error returns a pointer into the context's message buffer, which a
   #    Fortran string cannot borrow safely; the module's mpmc_context_last_error is a Fortran
   #    function of the same name that copies the message through mpmc_context_get_last_error.
-  set(NOT_BOUND mpmc_context_last_error)
+  #  - mpmc_sim_create_mpi takes an MPI_Comm, a C handle Fortran cannot pass; the module
+  #    binds mpmc_sim_create_mpi_f, which takes MPI's Fortran handle (MPI_Comm_f2c).
+  set(NOT_BOUND mpmc_context_last_error mpmc_sim_create_mpi)
 
   include(${CMAKE_CURRENT_LIST_DIR}/../libmpmc/public_api.cmake)
   string(REPLACE "," ";" HEADERS "${HEADERS}")
@@ -64,13 +66,13 @@ if(BUILD_SHARED_LIBS AND CMAKE_NM)
     list(APPEND libs mpmc_workflow)
   endif()
   foreach(lib IN LISTS libs)
-    set(header ${lib}.h)
+    set(headers ${PROJECT_SOURCE_DIR}/libmpmc/include/${lib}.h)
     if(lib STREQUAL "mpmc")
-      set(header mpmc.h)
+      list(JOIN MPMC_LIB_HEADERS "," headers) # mpmc.h (+ mpmc_mpi.h in an MPI build)
     endif()
     add_test(NAME t014-exported-symbols-${lib}
       COMMAND ${CMAKE_COMMAND} -DMODE=check -DNM=${CMAKE_NM}
-        -DHEADERS=${PROJECT_SOURCE_DIR}/libmpmc/include/${header} -DLIBRARY=$<TARGET_FILE:${lib}>
+        -DHEADERS=${headers} -DLIBRARY=$<TARGET_FILE:${lib}>
         -P ${PROJECT_SOURCE_DIR}/libmpmc/public_api.cmake)
     set_tests_properties(t014-exported-symbols-${lib} PROPERTIES LABELS unit)
   endforeach()

@@ -838,6 +838,9 @@ int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");
+  MPMC_CHECK(mpmc_dd_ranks(sim) == 1, ctx, MPMC_ERR_UNSUPPORTED,
+             "checkpoints of a run over %d MPI ranks are not supported yet (issue 47: one file "
+             "written collectively with parallel HDF5)", mpmc_dd_ranks(sim));
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "checkpoint: no grid set, nothing to save");
   const size_t len = strlen(path) + 5;
   char *tmp = malloc(len);

@@ -28,6 +28,7 @@ void mpmc_kinetic_damping(struct mpmc_sim_s *sim) {
     for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];
     e += p->m[q] * v2;
   }
+  mpmc_dd_sum(sim, &e, 1); /* MPI: over the ranks, the same bits on each */
   e *= 0.5;
   if (sim->kd_ke >= 0.0 && e < sim->kd_ke) { /* past the peak */
     const size_t nv = (size_t)p->n * (size_t)d;

@@ -154,6 +154,9 @@ int mpmc_output_create(mpmc_sim sim, const char *h5path, const char *xdmfpath, m
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(out, ctx, MPMC_ERR_ARG, "output handle pointer out is NULL");
+  MPMC_CHECK(mpmc_dd_ranks(sim) == 1, ctx, MPMC_ERR_UNSUPPORTED,
+             "snapshots of a run over %d MPI ranks are not supported yet (issue 47: one file "
+             "written collectively with parallel HDF5)", mpmc_dd_ranks(sim));
   MPMC_CHECK(h5path && h5path[0], ctx, MPMC_ERR_ARG, "HDF5 path h5path is NULL or empty");
   MPMC_CHECK(xdmfpath && xdmfpath[0], ctx, MPMC_ERR_ARG, "XDMF path xdmfpath is NULL or empty");
   MPMC_CHECK(strcmp(h5path, xdmfpath) != 0, ctx, MPMC_ERR_ARG,

@@ -38,11 +38,11 @@ static void signature(const mpmc_sim sim, double *sig) {
   double k = sim->nmat;
   for (int m = 0; m < sim->nmat; ++m) k += sim->mats[m].srm; /* strength reductions */
   sig[3] = k;
-  sig[4] = sim->p.n;
+  sig[4] = sim->dd ? (double)sim->np_global : sim->p.n; /* MPI: every rank's points */
   double w = 0.0;
   for (int i = 0; i < sim->nwall; ++i) w += sim->walls[i].active ? (double)(i + 1) : 0.0;
   sig[5] = w + 1e6 * sim->nwall;
-  sig[6] = sim->p.force != NULL;
+  sig[6] = sim->p.force != NULL && !sim->dd; /* MPI: a rank's own; sum |f| (sig[7]) counts */
 }
 
 /* Elastic energy density per reference volume of stress s (Voigt), J, material m. */
@@ -61,6 +61,8 @@ static double energy_density(const mpmc_material *m, const double *s, double J) 
 typedef struct {
   double ke, v2max, gx, fx, fabs, psi;
   int bad;
+  double v2mine; /* over MPI: this rank's largest |v|^2 (v2max: all ranks')             */
+  int bad_here;  /* over MPI: 1 on the rank of the failing point the message names        */
 } sums;
 
 static sums pass(const mpmc_sim sim, int with_psi) {
@@ -94,7 +96,15 @@ static sums pass(const mpmc_sim sim, int with_psi) {
     if (with_psi)
       psi += p->vol0[q] * energy_density(&mats[p->mat[q]], p->stress + (size_t)q * 6, p->J[q]);
   }
-  const sums s = {ke, v2max, gx, fx, fa, psi, bad};
+  sums s = {ke, v2max, gx, fx, fa, psi, bad, v2max, bad != INT_MAX};
+  if (sim->dd) { /* MPI: sums over the ranks in rank order, the lowest failing global id */
+    double t[5] = {ke, gx, fx, fa, psi}, mx[2] = {v2max, bad != INT_MAX ? -(double)p->id[bad] : -INFINITY};
+    mpmc_dd_sum(sim, t, 5);
+    mpmc_dd_max(sim, mx, 2);
+    s.ke = t[0], s.gx = t[1], s.fx = t[2], s.fabs = t[3], s.psi = t[4], s.v2max = mx[0];
+    s.bad_here = bad != INT_MAX && -(double)p->id[bad] == mx[1];
+    if (mx[1] > -INFINITY && !s.bad_here) s.bad = 0; /* fails on every rank, named by one */
+  }
   return s;
 }
 
@@ -125,6 +135,7 @@ int mpmc_monitor_step(mpmc_sim sim) {
 
   const sums s = pass(sim, changed && energy);
   if (s.bad != INT_MAX) {
+    if (!s.bad_here) return MPMC_DD_FOLLOW; /* MPI: the point's rank reports it */
     const double *x = p->x + (size_t)s.bad * d, *v = p->v + (size_t)s.bad * d;
     char nb[MPMC_POINT_NAME_LEN];
     return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
@@ -134,7 +145,7 @@ int mpmc_monitor_step(mpmc_sim sim) {
                       d == 3 ? x[2] : 0.0, v[0], v[1], d == 3 ? v[2] : 0.0);
   }
   /* a new baseline when the inputs changed, or sum |f| without a new force array */
-  if (changed || (energy && p->force && s.fabs != mo->sig[7])) {
+  if (changed || (energy && (p->force || sim->dd) && s.fabs != mo->sig[7])) {
     const sums sb = changed ? s : pass(sim, 1);
     baseline(mo, &sb, step, sig);
     mo->next_check = step + MPMC_MONITOR_EVERY;
@@ -153,11 +164,17 @@ int mpmc_monitor_step(mpmc_sim sim) {
   mo->next_check = step + (watch ? 1 : MPMC_MONITOR_EVERY);
   mo->ke_last = s.ke;
   if (!(s.ke > lim)) return MPMC_SUCCESS;
+  double jr[2] = {-INFINITY, -INFINITY}; /* -min J, max J for the hint below */
+  if (sim->fbar == MPMC_FBAR_TOTAL || sim->fbar == MPMC_FBAR_STABLE) {
+    for (int i = 0; i < p->n; ++i) jr[0] = fmax(jr[0], -p->J[i]), jr[1] = fmax(jr[1], p->J[i]);
+    mpmc_dd_max(sim, jr, 2); /* MPI: over the ranks */
+  }
+  if (sim->dd && !mpmc_dd_owner(sim, s.v2mine)) return MPMC_DD_FOLLOW; /* the fastest's rank */
   int q = 0; /* the fastest point, for the message */
   for (int i = 0; i < p->n; ++i) {
     double v2 = 0.0;
     for (int a = 0; a < d; ++a) v2 += p->v[(size_t)i * d + a] * p->v[(size_t)i * d + a];
-    if (v2 >= s.v2max) {
+    if (v2 >= s.v2mine) {
       q = i;
       break;
     }
@@ -168,8 +185,7 @@ int mpmc_monitor_step(mpmc_sim sim) {
    * flow (splashing, run-up; docs/theory.md): say so, with the range of J. */
   char hint[256] = "";
   if (sim->fbar == MPMC_FBAR_TOTAL || sim->fbar == MPMC_FBAR_STABLE) {
-    double jmin = INFINITY, jmax = -INFINITY;
-    for (int i = 0; i < p->n; ++i) jmin = fmin(jmin, p->J[i]), jmax = fmax(jmax, p->J[i]);
+    const double jmin = -jr[0], jmax = jr[1];
     snprintf(hint, sizeof hint,
              "; or, in a large flow, use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene "
              "'fbar: true'): the %s form projects the points' own J, which drift in a flow "

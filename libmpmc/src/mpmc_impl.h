@@ -81,6 +81,7 @@ typedef struct {
   int nustate;
   int *id;       /* [n] the index each point had when added (allocated by the first sort or
                     mpmc_sim_get_particle_ids; NULL: ids are the indices) (sort.c)      */
+  int global_ids; /* over MPI: ids are indices among every rank's points (always named)  */
   /* step scratch */
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
   double *xn;    /* [n][dim] with F-bar's stable form x^n, from G2P (which moves x) to the
@@ -95,7 +96,7 @@ typedef struct {
  * when a sort by cell has moved it, e.g. "57 (id 1203)". */
 #define MPMC_POINT_NAME_LEN 40
 static inline const char *mpmc_point_name(const mpmc_particles *p, int q, char *buf) {
-  if (p->id && p->id[q] != q)
+  if (p->id && (p->id[q] != q || p->global_ids))
     snprintf(buf, MPMC_POINT_NAME_LEN, "%d (id %d)", q, p->id[q]);
   else
     snprintf(buf, MPMC_POINT_NAME_LEN, "%d", q);
@@ -455,6 +456,8 @@ struct mpmc_sim_s {
    * until mpmc_sim_restore_field: both clear it) */
   double v2max;
   int v2max_ok, v_borrowed;
+  struct mpmc_dd_s *dd; /* the MPI decomposition (mpi.c); NULL: one process            */
+  int64_t np_global;    /* points added so far over all ranks (their ids: 0 ..)        */
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),
@@ -567,5 +570,27 @@ int mpmc_contact_check(struct mpmc_sim_s *sim);
 void mpmc_contact_step(struct mpmc_sim_s *sim, int begin);
 /* sets.c */
 void mpmc_sets_free(struct mpmc_sim_s *sim);
+
+/* mpi.c: the MPI decomposition; every function is a no-op (one process) when sim->dd is
+ * NULL, as always in a build without MPI. */
+#define MPMC_DD_MIN_CELLS 5 /* a slab's least width: only two ranks reach a halo node    */
+enum { MPMC_DD_NODES = 0, MPMC_DD_FBAR = 1 }; /* what mpmc_dd_halo exchanges              */
+/* An error a rank returns when it knows the step fails but another rank holds the point the
+ * message names (mpmc_dd_agree takes that rank's message). */
+#define MPMC_DD_FOLLOW (-1)
+int mpmc_dd_setup(struct mpmc_sim_s *sim);
+int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x);
+/* collective: the same error code and message on every rank (MPMC_DD_FOLLOW: see above) */
+int mpmc_dd_agree(struct mpmc_sim_s *sim, int err);
+int mpmc_dd_halo(struct mpmc_sim_s *sim, int what);
+int mpmc_dd_migrate(struct mpmc_sim_s *sim);
+/* v[0 .. n) summed over the ranks in rank order (the same bits on every rank) / maximum */
+void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n);
+void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n);
+/* 1 on the (lowest) rank whose v is the largest */
+int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v);
+/* the number of ranks (1 in one process) */
+int mpmc_dd_ranks(const struct mpmc_sim_s *sim);
+void mpmc_dd_free(struct mpmc_sim_s *sim);
 
 #endif

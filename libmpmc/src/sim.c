@@ -120,6 +120,7 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
 int mpmc_sim_destroy(mpmc_sim *sim) {
   if (!sim || !*sim) return MPMC_SUCCESS;
   mpmc_sim s = *sim;
+  mpmc_dd_free(s);
   mpmc_return_map_free(s);
   mpmc_contact_free(s);
   mpmc_sets_free(s);
@@ -162,6 +163,7 @@ int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h
   MPMC_CHECK(!sim->node_sets || sim->node_sets->n == 0, sim->ctx, MPMC_ERR_STATE,
              "the grid must be set before node sets are added");
   MPMC_CALL(mpmc_grid_setup(sim->ctx, &sim->grid, sim->dim, lo, hi, h));
+  MPMC_CALL(mpmc_dd_setup(sim)); /* MPI: the ranks' slabs of this grid */
   sim->prepared = 0;
   sim->walls_dirty = 1;
   return MPMC_SUCCESS;
@@ -314,6 +316,9 @@ int mpmc_sim_set_force_dt(mpmc_sim sim, int force) {
  * @param volume initial volumes [n] (> 0; per unit thickness in 2D)
  * @param material id from an mpmc_sim_add_material_* call
  * @param[out] first index of the first new point (may be NULL)
+ * Over MPI (mpmc_sim_create_mpi) every rank passes the same points and keeps those in its
+ * slab; first is then the index of this rank's first new point, and the points' ids are
+ * their indices among all points added.
  */
 int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *volume, int material,
                            int *first) {
@@ -344,13 +349,22 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
                  i, lp, 0.5 * g->h);
     }
   }
+  MPMC_CHECK(sim->np_global + n <= INT32_MAX, ctx, MPMC_ERR_ARG, "too many material points");
   int cap = p->cap ? p->cap : 64;
   while (cap < p->n + n) cap = cap > INT32_MAX / 2 ? INT32_MAX : 2 * cap;
   MPMC_CALL(mpmc_particles_reserve(ctx, p, cap));
+  p->global_ids = sim->dd != NULL;
+  if (sim->dd && !p->id) { /* over MPI a point's id is its global index */
+    p->id = malloc(sizeof(int) * (size_t)p->cap);
+    MPMC_CHECK(p->id, ctx, MPMC_ERR_MEMORY, "cannot allocate the ids of %d points", p->cap);
+    for (int q = 0; q < p->n; ++q) p->id[q] = q;
+  }
   const mpmc_material *m = &sim->mats[material];
   const int n0 = p->n;
+  size_t q = (size_t)n0 - 1;
   for (int i = 0; i < n; ++i) {
-    const size_t q = (size_t)(n0 + i);
+    if (sim->dd && !mpmc_dd_keep(sim, x + (size_t)i * d)) continue; /* another rank's */
+    ++q;
     for (int a = 0; a < d; ++a) {
       p->x[q * d + a] = x[(size_t)i * d + a];
       p->x0[q * d + a] = x[(size_t)i * d + a];
@@ -361,7 +375,8 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
     p->J[q] = 1.0;
     for (int k = 0; k < 6; ++k) p->stress[q * 6 + k] = 0.0;
     p->mat[q] = material;
-    if (p->id) p->id[q] = (int)q; /* a point's id is its index when added */
+    if (p->id) /* a point's id is its index when added (over all ranks) */
+      p->id[q] = sim->dd ? (int)(sim->np_global + i) : (int)q;
     if (p->Jbar) p->Jbar[q] = 1.0;
     if (p->be)
       for (int k = 0; k < 6; ++k) p->be[q * 6 + k] = k < 3 ? 1.0 : 0.0;
@@ -376,7 +391,8 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
       for (int a = 0; a < d; ++a) p->cforce[q * d + a] = 0.0;
     for (int k = 0; k < p->nustate; ++k) p->ustate[q * (size_t)p->nustate + k] = 0.0;
   }
-  p->n = n0 + n;
+  p->n = (int)(q + 1);
+  sim->np_global += n;
   if (first) *first = n0;
   sim->prepared = 0;
   return MPMC_SUCCESS;
@@ -573,6 +589,7 @@ int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke) {
     for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];
     e += 0.5 * p->m[q] * v2;
   }
+  mpmc_dd_sum(sim, &e, 1); /* MPI: over the ranks (collective) */
   *ke = e;
   return MPMC_SUCCESS;
 }

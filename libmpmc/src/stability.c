@@ -27,6 +27,7 @@ double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
       if (v2 > vmax) vmax = v2;
     }
   }
+  mpmc_dd_max(sim, &vmax, 1); /* MPI: over the ranks (collective) */
   vmax = sqrt(vmax);
   double dt = cmax + vmax > 0 ? sim->grid.h / (cmax + vmax) : INFINITY;
   if (visc < dt) dt = visc;

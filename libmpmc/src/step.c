@@ -81,10 +81,15 @@ static void lap(mpmc_sim sim, int ph, double *t) {
   sim->stats.phase_seconds[ph] += t1 - *t;
   *t = t1;
 }
-#define PHASE(sim, ph, t, call) \
-  do {                          \
-    MPMC_CALL(call);            \
-    lap(sim, ph, t);            \
+/* Over MPI every phase ends with the ranks' agreement (mpi.c, mpmc_dd_agree): a failure
+ * on one rank fails the step on all with the same message before anyone waits in an
+ * exchange; in one process (sim->dd NULL) the call's code as it is. */
+#define PHASE(sim, ph, t, call)                                  \
+  do {                                                           \
+    int phase_err_ = (call);                                     \
+    if ((sim)->dd) phase_err_ = mpmc_dd_agree(sim, phase_err_);  \
+    if (phase_err_) return phase_err_;                           \
+    lap(sim, ph, t);                                             \
   } while (0)
 
 static int step_phases(mpmc_sim sim, double dt, double *t) {
@@ -93,14 +98,17 @@ static int step_phases(mpmc_sim sim, double dt, double *t) {
   mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
   PHASE(sim, MPMC_PHASE_SLABS, t, k->slabs(sim));     /* this step's box, P2G's colouring */
   PHASE(sim, MPMC_PHASE_P2G, t, k->p2g(sim, dt));     /* mass, momentum, forces   (eqs 7, 8, 10) */
+  if (sim->dd) PHASE(sim, MPMC_PHASE_P2G, t, mpmc_dd_halo(sim, MPMC_DD_NODES)); /* MPI: halo sums */
   PHASE(sim, MPMC_PHASE_GRID, t, k->grid_update(sim, dt)); /* velocities, walls, damping (eq 9) */
   PHASE(sim, MPMC_PHASE_G2P, t, k->g2p(sim, dt));     /* v, dF, J, x              (eqs 13-17)    */
   if (sim->kdamp) mpmc_kinetic_damping(sim);          /* v = 0 at a peak of E_k (damping.c) */
+  if (sim->fbar && sim->dd) PHASE(sim, MPMC_PHASE_FBAR, t, mpmc_dd_halo(sim, MPMC_DD_FBAR));
   if (sim->fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim, 1)); /* dF -> dF-bar (Alg. 1, 2-4)   */
   PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar);
                                    the built-in materials run F-bar's gather themselves */
   if (sim->bodies) MPMC_CALL(mpmc_contact_check(sim)); /* no point inside a rigid body */
   PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_monitor_step(sim)); /* NaN velocity, energy growth */
+  if (sim->dd) PHASE(sim, MPMC_PHASE_SORT, t, mpmc_dd_migrate(sim)); /* MPI: points to their slabs */
   return MPMC_SUCCESS;
 }
 
@@ -114,8 +122,10 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(isfinite(dt) && dt > 0, ctx, MPMC_ERR_ARG, "time step dt = %g must be > 0", dt);
-  MPMC_CHECK(sim->nmat > 0 && sim->p.n > 0, ctx, MPMC_ERR_STATE,
+  MPMC_CHECK(sim->nmat > 0 && (sim->dd ? sim->np_global : sim->p.n) > 0, ctx, MPMC_ERR_STATE,
              "nothing to step: add a material and material points first");
+  MPMC_CHECK(!sim->dd || !sim->bodies, ctx, MPMC_ERR_UNSUPPORTED,
+             "rigid bodies are not supported over MPI yet (issue 47)");
   MPMC_CALL(mpmc_sim_prepare(sim));
 #ifdef _OPENMP
   const int saved = omp_get_max_threads();
@@ -135,6 +145,7 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   }
   lap(sim, MPMC_PHASE_CHECKS, &t);
   if (!err) err = mpmc_sort_due(sim); /* locality: points by cell (sort.c), if asked for */
+  if (sim->dd) err = mpmc_dd_agree(sim, err);
   lap(sim, MPMC_PHASE_SORT, &t);
   if (!err) err = step_phases(sim, dt, &t);
   if (sim->bodies) mpmc_contact_step(sim, 0);

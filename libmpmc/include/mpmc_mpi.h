@@ -1,0 +1,34 @@
+/* libmpmc over MPI: a simulation bound to a communicator (docs/mpi.md).
+ *
+ * Only in a build with -DMPMC_WITH_MPI=ON (libmpmc then links MPI).  The grid is cut into
+ * slabs of whole cells along its longest axis, one per rank; each rank keeps the material
+ * points that lie in its slab and the nodes their stencils reach.  Every other function of
+ * mpmc.h takes such a simulation unchanged and is collective over the communicator: set-up,
+ * adding or seeding points (every rank passes the same points and keeps those of its slab;
+ * their ids, mpmc_sim_get_particle_ids, are their global indices), stepping.  The fields
+ * (mpmc_sim_get_field) are the rank's own points. */
+#ifndef MPMC_MPI_H
+#define MPMC_MPI_H
+
+#include <mpi.h>
+
+#include "mpmc.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+int mpmc_sim_create_mpi(mpmc_context ctx, MPI_Comm comm, int dim, mpmc_sim *sim);
+/* The same for Fortran: comm is MPI's Fortran handle (mpi_f08's comm%MPI_VAL, or the
+ * integer of the mpi module). */
+int mpmc_sim_create_mpi_f(mpmc_context ctx, MPI_Fint comm, int dim, mpmc_sim *sim);
+/* This rank's place in the decomposition: its rank and the number of ranks, the slab axis
+ * and the slab's cells [cell_lo, cell_hi) along it (grid cell 0 is the first ghost cell
+ * below the box); the simulation's grid must be set.  Any argument may be NULL. */
+int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis, int *cell_lo,
+                          int *cell_hi);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* MPMC_MPI_H */

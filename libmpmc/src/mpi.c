@@ -1,0 +1,681 @@
+/* Distributed runs over MPI (issue 47; docs/mpi.md).  Compiled into every build; the
+ * functions below do something only in a build with MPMC_HAVE_MPI and for a simulation made
+ * by mpmc_sim_create_mpi (sim->dd set): a serial run never calls MPI.
+ *
+ * Decomposition.  The grid's cells along its longest axis (ties: the outermost) are cut
+ * into one slab per rank, cut[r] .. cut[r + 1] - 1, as even as whole cells allow.  Rank r
+ * owns the points whose cell along that axis lies in its slab.  A point in cell c reaches
+ * nodes c - 1 .. c + 2 along each axis (the cubic B-spline's stencil, the widest; transfer.h),
+ * so rank r's points touch node planes cut[r] - 1 .. cut[r + 1] + 1 and its neighbours'
+ * touch planes from cut[r + 1] - 1 on: the planes b - 2 .. b + 2 around each cut b (one more
+ * each way than the stencils need) form the boundary's halo, which only the two ranks
+ * either side of it reach when every slab is at least MPMC_DD_MIN_CELLS wide.
+ *
+ * Halo sums.  After P2G (mass, momentum, force, and F-bar's nodal volume in the records'
+ * MPMC_VSLOT) and after G2P's F-bar scatter (fbj, or fb in the stable form) each rank sends
+ * its partial sums over its active box's part of each halo to the neighbour across it and
+ * adds the neighbour's to its own: every halo node then holds the same sum, own + other, on
+ * both ranks (one addition of two numbers, which is commutative: the same bits whatever
+ * the order of arrival).  Both ranks then run the grid update on the halo nodes with the
+ * same inputs and get the same velocities, so no second exchange is needed before G2P: the
+ * owner's "send the updated halo back" is replaced by the same arithmetic done twice.  The
+ * receiver's active box (and its rows' x ranges) grows to cover the sender's, so the
+ * nodes it was sent are updated and cleared like its own.  The only difference from the
+ * serial run is that order: a halo node's sum is (lower rank's points) + (upper rank's
+ * points) instead of one sum in the serial slab order (round-off, tests/mpi).
+ *
+ * Migration.  After each step a point whose cell left the slab moves, with every per-point
+ * field, its material id, global id and particle-set membership, to the neighbour whose
+ * slab it entered; a point that went further than a neighbour stops the run.
+ *
+ * Failures.  Every phase of an MPI step ends with mpmc_dd_agree: a failure on any rank
+ * becomes the same error code and message on every rank (the lowest failing rank's,
+ * prefixed with "rank r of n: "), so that no rank waits in an exchange the others left. */
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mpmc_impl.h"
+#include "sets.h"
+
+#ifndef MPMC_HAVE_MPI
+
+int mpmc_dd_agree(struct mpmc_sim_s *sim, int err) { return (void)sim, err < 0 ? MPMC_SUCCESS : err; }
+int mpmc_dd_halo(struct mpmc_sim_s *sim, int what) { return (void)sim, (void)what, MPMC_SUCCESS; }
+int mpmc_dd_migrate(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
+int mpmc_dd_setup(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
+int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) { return (void)sim, (void)x, 1; }
+void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
+void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
+int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) { return (void)sim, (void)v, 1; }
+void mpmc_dd_free(struct mpmc_sim_s *sim) { (void)sim; }
+int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return (void)sim, 1; }
+
+#else /* MPMC_HAVE_MPI */
+
+#include <mpi.h>
+
+#include "mpmc_mpi.h"
+
+struct mpmc_dd_s {
+  MPI_Comm comm;      /* a duplicate of the caller's: our messages never meet theirs */
+  int rank, size;
+  int axis;           /* the slab axis; -1 until the grid is set                        */
+  int *cut;           /* [size + 1] each rank's first cell along axis; cut[size]: cells  */
+  double *buf;        /* message buffers: send lower, send upper, receive lower, upper   */
+  size_t cap;         /* doubles in each of the four                                      */
+  double *gather;     /* [size * n] mpmc_dd_sum's                                         */
+  int cap_gather;
+};
+
+enum { TAG_HALO = 4701, TAG_MIGRATE_N = 4702, TAG_MIGRATE = 4703 };
+
+/* The lower and upper neighbours (MPI_PROC_NULL at the ends: messages to it are no-ops). */
+static int lower(const struct mpmc_dd_s *dd) { return dd->rank > 0 ? dd->rank - 1 : MPI_PROC_NULL; }
+static int upper(const struct mpmc_dd_s *dd) {
+  return dd->rank + 1 < dd->size ? dd->rank + 1 : MPI_PROC_NULL;
+}
+
+static int create(mpmc_context ctx, MPI_Comm comm, int dim, mpmc_sim *sim) {
+  if (!ctx || !sim) return ctx ? MPMC_ERROR(ctx, MPMC_ERR_ARG, "sim pointer is NULL") : MPMC_ERR_ARG;
+  int init = 0;
+  MPI_Initialized(&init);
+  MPMC_CHECK(init, ctx, MPMC_ERR_STATE, "mpmc_sim_create_mpi: call MPI_Init first");
+  MPMC_CHECK(comm != MPI_COMM_NULL, ctx, MPMC_ERR_ARG, "mpmc_sim_create_mpi: comm is MPI_COMM_NULL");
+  struct mpmc_dd_s *dd = calloc(1, sizeof *dd);
+  MPMC_CHECK(dd, ctx, MPMC_ERR_MEMORY, "cannot allocate the decomposition");
+  dd->axis = -1;
+  MPI_Comm_dup(comm, &dd->comm);
+  MPI_Comm_rank(dd->comm, &dd->rank);
+  MPI_Comm_size(dd->comm, &dd->size);
+  mpmc_sim s = NULL;
+  const int err = mpmc_sim_create(ctx, dim, &s);
+  if (err) {
+    MPI_Comm_free(&dd->comm);
+    free(dd);
+    return err;
+  }
+  s->dd = dd;
+  *sim = s;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Create a simulation distributed over the ranks of comm (collective; mpmc_mpi.h).
+ *        The communicator is duplicated; the caller may free its own.
+ * @param comm an intra-communicator; MPI must be initialised
+ */
+int mpmc_sim_create_mpi(mpmc_context ctx, MPI_Comm comm, int dim, mpmc_sim *sim) {
+  return create(ctx, comm, dim, sim);
+}
+
+/** @brief mpmc_sim_create_mpi for Fortran: comm is MPI's Fortran handle (MPI_Comm_f2c). */
+int mpmc_sim_create_mpi_f(mpmc_context ctx, MPI_Fint comm, int dim, mpmc_sim *sim) {
+  return create(ctx, MPI_Comm_f2c(comm), dim, sim);
+}
+
+/** @brief This rank's place in the decomposition (mpmc_mpi.h); NULL arguments are skipped. */
+int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis, int *cell_lo,
+                          int *cell_hi) {
+  if (!sim) return MPMC_ERR_ARG;
+  const struct mpmc_dd_s *dd = sim->dd;
+  MPMC_CHECK(dd, sim->ctx, MPMC_ERR_STATE, "not a simulation of mpmc_sim_create_mpi");
+  MPMC_CHECK(dd->axis >= 0, sim->ctx, MPMC_ERR_STATE, "the decomposition needs the grid: set it first");
+  if (rank) *rank = dd->rank;
+  if (nranks) *nranks = dd->size;
+  if (axis) *axis = dd->axis;
+  if (cell_lo) *cell_lo = dd->cut[dd->rank];
+  if (cell_hi) *cell_hi = dd->cut[dd->rank + 1];
+  return MPMC_SUCCESS;
+}
+
+int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return sim->dd ? sim->dd->size : 1; }
+
+void mpmc_dd_free(struct mpmc_sim_s *sim) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!dd) return;
+  int fin = 0;
+  MPI_Finalized(&fin);
+  if (!fin) MPI_Comm_free(&dd->comm);
+  free(dd->cut);
+  free(dd->buf);
+  free(dd->gather);
+  free(dd);
+  sim->dd = NULL;
+}
+
+/* The slabs of the grid just set (mpmc_sim_set_grid). */
+int mpmc_dd_setup(struct mpmc_sim_s *sim) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!dd) return MPMC_SUCCESS;
+  const mpmc_grid *g = &sim->grid;
+  int ax = sim->dim - 1;
+  for (int a = sim->dim - 2; a >= 0; --a)
+    if (g->n[a] > g->n[ax]) ax = a;
+  const int cells = g->n[ax] - 1;
+  MPMC_CHECK(cells >= MPMC_DD_MIN_CELLS * dd->size, sim->ctx, MPMC_ERR_ARG,
+             "the grid has %d cells (ghost layers included) along its longest axis %d: too few "
+             "for %d ranks, whose slabs need %d cells each; use at most %d ranks or a finer grid",
+             cells, ax, dd->size, MPMC_DD_MIN_CELLS, cells / MPMC_DD_MIN_CELLS);
+  int *cut = realloc(dd->cut, sizeof(int) * (size_t)(dd->size + 1));
+  MPMC_CHECK(cut, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the slab cuts");
+  for (int r = 0; r <= dd->size; ++r) cut[r] = (int)((long long)cells * r / dd->size);
+  dd->cut = cut;
+  dd->axis = ax;
+  return MPMC_SUCCESS;
+}
+
+/* The cell of position x along the slab axis, clamped to the grid (as p2g.c's count_chunk). */
+static int slab_cell(const struct mpmc_sim_s *sim, const double *x) {
+  const mpmc_grid *g = &sim->grid;
+  const int ax = sim->dd->axis;
+  const double s = (x[ax] - g->origin[ax]) * g->inv_h;
+  return s >= 0.0 ? (s < g->n[ax] - 1 ? (int)s : g->n[ax] - 2) : 0;
+}
+
+/* The rank whose slab holds cell c. */
+static int rank_of_cell(const struct mpmc_dd_s *dd, int c) {
+  int lo = 0, hi = dd->size - 1;
+  while (lo < hi) {
+    const int mid = (lo + hi + 1) / 2;
+    if (dd->cut[mid] <= c)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  return lo;
+}
+
+int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) {
+  if (!sim->dd) return 1;
+  const int c = slab_cell(sim, x);
+  return c >= sim->dd->cut[sim->dd->rank] && c < sim->dd->cut[sim->dd->rank + 1];
+}
+
+/* ---- agreement and reductions --------------------------------------------------------- */
+
+int mpmc_dd_agree(struct mpmc_sim_s *sim, int err) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!dd) return err < 0 ? MPMC_SUCCESS : err;
+  /* a real failure first, then a follower's (MPMC_DD_FOLLOW: a rank that knows the run
+   * fails but leaves the message to the rank that has the point), lowest rank first */
+  const int key = err > 0 ? dd->rank : err < 0 ? dd->size + dd->rank : 2 * dd->size;
+  int root = 0;
+  MPI_Allreduce(&key, &root, 1, MPI_INT, MPI_MIN, dd->comm);
+  if (root == 2 * dd->size) return MPMC_SUCCESS;
+  root %= dd->size;
+  mpmc_context ctx = sim->ctx;
+  int code = err;
+  char msg[MPMC_MSG_LEN];
+  if (dd->rank == root) {
+    if (code <= 0) code = MPMC_ERR_STATE; /* a follower without a leader: cannot happen */
+    /* the message names the rank once (an error agreed already keeps its name) */
+    const int k = strncmp(ctx->last_msg, "rank ", 5) ? snprintf(msg, 32, "rank %d of %d: ", dd->rank, dd->size) : 0;
+    memcpy(msg + k, ctx->last_msg, MPMC_MSG_LEN - (size_t)k - 1);
+    msg[MPMC_MSG_LEN - 1] = '\0';
+  }
+  MPI_Bcast(&code, 1, MPI_INT, root, dd->comm);
+  MPI_Bcast(msg, MPMC_MSG_LEN, MPI_CHAR, root, dd->comm);
+  msg[MPMC_MSG_LEN - 1] = '\0';
+  ctx->last_code = code;
+  memcpy(ctx->last_msg, msg, MPMC_MSG_LEN);
+  return code;
+}
+
+/* v[0 .. n) summed over the ranks in rank order on every rank: the same bits everywhere
+ * and from run to run (an MPI_Allreduce may sum in any order). */
+void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!dd || n <= 0) return;
+  double local[16];
+  if (n > 16 || dd->size * n > dd->cap_gather) {
+    double *gb = realloc(dd->gather, sizeof(double) * (size_t)dd->size * (size_t)(n > 16 ? n : 16));
+    if (!gb) { /* cannot happen for the few values summed; fall back to MPI's order */
+      MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, dd->comm);
+      return;
+    }
+    dd->gather = gb;
+    dd->cap_gather = dd->size * (n > 16 ? n : 16);
+  }
+  double *in = v;
+  if (n <= 16) {
+    memcpy(local, v, sizeof(double) * (size_t)n);
+    in = local;
+  }
+  MPI_Allgather(in, n, MPI_DOUBLE, dd->gather, n, MPI_DOUBLE, dd->comm);
+  for (int k = 0; k < n; ++k) {
+    double s = dd->gather[k];
+    for (int r = 1; r < dd->size; ++r) s += dd->gather[(size_t)r * n + k];
+    v[k] = s;
+  }
+}
+
+void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) {
+  if (!sim->dd || n <= 0) return;
+  MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, sim->dd->comm);
+}
+
+/* 1 on the lowest rank whose v is the largest over the ranks, 0 on the others. */
+int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) {
+  const struct mpmc_dd_s *dd = sim->dd;
+  if (!dd) return 1;
+  struct {
+    double v;
+    int r;
+  } in = {v, dd->rank}, out;
+  MPI_Allreduce(&in, &out, 1, MPI_DOUBLE_INT, MPI_MAXLOC, dd->comm);
+  return out.r == dd->rank;
+}
+
+/* ---- halo sums ---------------------------------------------------------------------- */
+
+static int reserve_buf(struct mpmc_sim_s *sim, size_t each) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (each <= dd->cap) return MPMC_SUCCESS;
+  free(dd->buf);
+  dd->buf = malloc(sizeof(double) * 4 * each);
+  dd->cap = dd->buf ? each : 0;
+  MPMC_CHECK(dd->buf, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %zu halo values", 4 * each);
+  return MPMC_SUCCESS;
+}
+
+/* Grow the active box to hold [lo, hi) and each of the box's rows' x ranges to hold
+ * [lo[0], hi[0]) in the rows of [lo, hi): rows new to the box start empty. */
+static void grow_box(mpmc_grid *g, const int *lo, const int *hi) {
+  int olo[3], ohi[3], empty = 0;
+  for (int a = 0; a < 3; ++a) {
+    olo[a] = g->act_lo[a];
+    ohi[a] = g->act_hi[a];
+    empty |= ohi[a] <= olo[a];
+  }
+  int nlo[3], nhi[3];
+  for (int a = 0; a < 3; ++a) {
+    nlo[a] = empty || lo[a] < olo[a] ? lo[a] : olo[a];
+    nhi[a] = empty || hi[a] > ohi[a] ? hi[a] : ohi[a];
+  }
+  const size_t n1 = (size_t)g->n[1];
+  for (int k = nlo[2]; k < nhi[2]; ++k)
+    for (int j = nlo[1]; j < nhi[1]; ++j) {
+      int *rx = g->rowx + 2 * ((size_t)j + n1 * (size_t)k);
+      if (empty || j < olo[1] || j >= ohi[1] || k < olo[2] || k >= ohi[2]) rx[0] = rx[1] = nlo[0];
+      if (j < lo[1] || j >= hi[1] || k < lo[2] || k >= hi[2]) continue;
+      if (rx[1] <= rx[0]) {
+        rx[0] = lo[0];
+        rx[1] = hi[0];
+      } else {
+        rx[0] = lo[0] < rx[0] ? lo[0] : rx[0];
+        rx[1] = hi[0] > rx[1] ? hi[0] : rx[1];
+      }
+    }
+  for (int a = 0; a < 3; ++a) {
+    g->act_lo[a] = nlo[a];
+    g->act_hi[a] = nhi[a];
+  }
+}
+
+/* The halo of the cut between ranks r - 1 and r (r in 1 .. size - 1) within the active box,
+ * into lo/hi; 0 if empty. */
+static int halo_box(const struct mpmc_sim_s *sim, int r, int *lo, int *hi) {
+  const mpmc_grid *g = &sim->grid;
+  const int ax = sim->dd->axis, b = sim->dd->cut[r];
+  int empty = 0;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = g->act_lo[a];
+    hi[a] = g->act_hi[a];
+    if (a == ax) {
+      lo[a] = b - 2 > lo[a] ? b - 2 : lo[a];
+      hi[a] = b + 3 < hi[a] ? b + 3 : hi[a];
+    }
+    empty |= hi[a] <= lo[a];
+  }
+  return !empty;
+}
+
+/* Pack the box [lo, hi) of arr (width doubles per node) after a header of the box. */
+static size_t pack(const mpmc_grid *g, const double *arr, int width, int ok, const int *lo,
+                   const int *hi, double *out) {
+  for (int a = 0; a < 3; ++a) {
+    out[a] = ok ? lo[a] : 0;
+    out[3 + a] = ok ? hi[a] : 0;
+  }
+  size_t k = 6;
+  if (!ok) return k;
+  const size_t len = (size_t)(hi[0] - lo[0]) * (size_t)width;
+  for (int z = lo[2]; z < hi[2]; ++z)
+    for (int y = lo[1]; y < hi[1]; ++y) {
+      const size_t i0 = (size_t)lo[0] + (size_t)g->n[0] * ((size_t)y + (size_t)g->n[1] * (size_t)z);
+      memcpy(out + k, arr + i0 * (size_t)width, len * sizeof(double));
+      k += len;
+    }
+  return k;
+}
+
+/* Add a neighbour's packed box into arr (growing the active box to hold it). */
+static void unpack_add(mpmc_grid *g, double *arr, int width, const double *in) {
+  int lo[3], hi[3], empty = 0;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = (int)in[a];
+    hi[a] = (int)in[3 + a];
+    empty |= hi[a] <= lo[a];
+  }
+  if (empty) return;
+  grow_box(g, lo, hi);
+  size_t k = 6;
+  const size_t len = (size_t)(hi[0] - lo[0]) * (size_t)width;
+  for (int z = lo[2]; z < hi[2]; ++z)
+    for (int y = lo[1]; y < hi[1]; ++y) {
+      const size_t i0 = (size_t)lo[0] + (size_t)g->n[0] * ((size_t)y + (size_t)g->n[1] * (size_t)z);
+      double *restrict d = arr + i0 * (size_t)width;
+      const double *restrict s = in + k;
+      for (size_t i = 0; i < len; ++i) d[i] += s[i];
+      k += len;
+    }
+}
+
+/* Walls that mirror ghost nodes across a node plane along the slab axis fold nodes up to
+ * MPMC_GHOST planes either side of it into one another (grid_update.c): those planes must
+ * not reach a halo, whose nodes only the halo sums complete. */
+static int check_mirrors(struct mpmc_sim_s *sim) {
+  const struct mpmc_dd_s *dd = sim->dd;
+  for (int w = 0; w < sim->nmirror; ++w) {
+    const mpmc_mirror *m = &sim->mirrors[w];
+    if (m->axis != dd->axis) continue;
+    for (int r = 1; r < dd->size; ++r) {
+      const int b = dd->cut[r];
+      MPMC_CHECK(m->plane + MPMC_GHOST < b - 2 || m->plane - MPMC_GHOST > b + 2, sim->ctx,
+                 MPMC_ERR_UNSUPPORTED,
+                 "a wall on node plane %d of axis %d lies within %d cells of the cut between "
+                 "ranks %d and %d (cell %d): walls so close to a slab boundary are not supported "
+                 "over MPI yet; use another number of ranks",
+                 m->plane, m->axis, MPMC_GHOST + 2, r - 1, r, b);
+    }
+  }
+  return MPMC_SUCCESS;
+}
+
+/* Exchange and add the halo sums of what (MPMC_DD_NODES: the node records after P2G;
+ * MPMC_DD_FBAR: F-bar's fbj or fb after G2P's scatter) with both neighbours. */
+int mpmc_dd_halo(struct mpmc_sim_s *sim, int what) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!dd || dd->size == 1) return MPMC_SUCCESS;
+  mpmc_grid *g = &sim->grid;
+  double *arr;
+  int width;
+  if (what == MPMC_DD_NODES) {
+    if (sim->walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim)); /* the mirrors */
+    MPMC_CALL(check_mirrors(sim));
+    arr = g->node;
+    width = MPMC_NREC;
+  } else if (sim->fbar == MPMC_FBAR_STABLE) {
+    arr = g->fb;
+    width = 2;
+  } else {
+    arr = g->fbj;
+    width = 1;
+  }
+  const int ax = dd->axis;
+  size_t plane = 1;
+  for (int a = 0; a < 3; ++a)
+    if (a != ax) plane *= (size_t)g->n[a];
+  const size_t each = 6 + 5 * plane * (size_t)width;
+  MPMC_CALL(reserve_buf(sim, each));
+  double *sl = dd->buf, *su = sl + each, *rl = su + each, *ru = rl + each;
+  int lo[3], hi[3];
+  /* the box of what this rank sends is its active box before the neighbours' grow it */
+  const int okl = dd->rank > 0 && halo_box(sim, dd->rank, lo, hi);
+  const size_t nl = pack(g, arr, width, okl, lo, hi, sl);
+  const int oku = dd->rank + 1 < dd->size && halo_box(sim, dd->rank + 1, lo, hi);
+  const size_t nu = pack(g, arr, width, oku, lo, hi, su);
+  MPI_Request req[4];
+  MPI_Irecv(rl, (int)each, MPI_DOUBLE, lower(dd), TAG_HALO, dd->comm, &req[0]);
+  MPI_Irecv(ru, (int)each, MPI_DOUBLE, upper(dd), TAG_HALO, dd->comm, &req[1]);
+  MPI_Isend(sl, (int)nl, MPI_DOUBLE, lower(dd), TAG_HALO, dd->comm, &req[2]);
+  MPI_Isend(su, (int)nu, MPI_DOUBLE, upper(dd), TAG_HALO, dd->comm, &req[3]);
+  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  /* the sends are done before the adds change arr; the two halos share no node */
+  if (dd->rank > 0) unpack_add(g, arr, width, rl);
+  if (dd->rank + 1 < dd->size) unpack_add(g, arr, width, ru);
+  return MPMC_SUCCESS;
+}
+
+/* ---- migration ------------------------------------------------------------------------ */
+
+/* The per-point fields that move with a point: doubles, with the value a receiver that
+ * lacks the field (not yet allocated there) fills in for its own points. */
+typedef struct {
+  double **a;
+  int nc;
+  double fill;
+} field;
+
+static int fields_of(struct mpmc_sim_s *sim, field *f) {
+  mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  int k = 0;
+  f[k++] = (field){&p->x, d, 0.0};
+  f[k++] = (field){&p->x0, d, 0.0};
+  f[k++] = (field){&p->v, d, 0.0};
+  f[k++] = (field){&p->m, 1, 0.0};
+  f[k++] = (field){&p->vol0, 1, 0.0};
+  f[k++] = (field){&p->J, 1, 1.0};
+  f[k++] = (field){&p->stress, 6, 0.0};
+  f[k++] = (field){&p->Jbar, 1, 1.0};
+  f[k++] = (field){&p->Janc, 1, 1.0};
+  f[k++] = (field){&p->be, 6, NAN}; /* NAN: the identity */
+  f[k++] = (field){&p->eps_p, 1, 0.0};
+  f[k++] = (field){&p->region, 1, 0.0};
+  f[k++] = (field){&p->Jp, 1, 1.0};
+  f[k++] = (field){&p->lp, 1, 0.0};
+  f[k++] = (field){&p->force, d, 0.0};
+  f[k++] = (field){&p->cforce, d, 0.0};
+  f[k++] = (field){&p->ustate, p->nustate, 0.0};
+  return k;
+}
+#define MAX_FIELDS 17
+
+/* Make sure the optional field f exists here (a sender had it). */
+static int ensure_field(struct mpmc_sim_s *sim, const field *f) {
+  if (*f->a || f->nc <= 0) return MPMC_SUCCESS;
+  mpmc_particles *p = &sim->p;
+  MPMC_CALL(mpmc_particles_ensure(sim->ctx, p, f->a, f->nc, isnan(f->fill) ? 0.0 : f->fill));
+  if (isnan(f->fill))
+    for (int q = 0; q < p->n; ++q)
+      for (int c = 0; c < 3; ++c) (*f->a)[(size_t)q * 6 + c] = 1.0;
+  return MPMC_SUCCESS;
+}
+
+/* Doubles per point in a message with the fields of mask, and the sets' flags. */
+static int record_len(const field *f, int nf, unsigned mask, int nsets) {
+  int len = 2 + nsets; /* material id, global id, set flags */
+  for (int k = 0; k < nf; ++k)
+    if (mask >> k & 1u) len += f[k].nc;
+  return len;
+}
+
+int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!dd || dd->size == 1) return MPMC_SUCCESS;
+  mpmc_context ctx = sim->ctx;
+  mpmc_particles *p = &sim->p;
+  const int n = p->n, me = dd->rank;
+  /* where each point goes: -1 down, 0 stays, 1 up; a point beyond a neighbour fails */
+  signed char *dest = malloc((size_t)(n > 0 ? n : 1));
+  int err = dest ? MPMC_SUCCESS : MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
+  int nout[2] = {0, 0};
+  for (int q = 0; q < n && !err; ++q) {
+    const int c = slab_cell(sim, p->x + (size_t)q * sim->dim);
+    const int r = c < dd->cut[me] || c >= dd->cut[me + 1] ? rank_of_cell(dd, c) : me;
+    dest[q] = (signed char)(r < me ? -1 : r > me);
+    if (r < me - 1 || r > me + 1) {
+      char nb[MPMC_POINT_NAME_LEN];
+      const double *x = p->x + (size_t)q * sim->dim;
+      err = MPMC_ERROR(ctx, MPMC_ERR_UNSTABLE,
+                       "step %lld, t = %g: point %s at (%g, %g, %g) moved from rank %d's slab "
+                       "(cells %d .. %d along axis %d) to rank %d's in one step, across more "
+                       "than one subdomain: reduce the time step or use fewer ranks",
+                       (long long)sim->stats.steps, sim->time, mpmc_point_name(p, q, nb), x[0],
+                       x[1], sim->dim == 3 ? x[2] : 0.0, me, dd->cut[me], dd->cut[me + 1] - 1,
+                       dd->axis, r);
+    } else if (r != me) {
+      nout[r > me]++;
+    }
+  }
+  err = mpmc_dd_agree(sim, err);
+  if (err) {
+    free(dest);
+    return err;
+  }
+  field f[MAX_FIELDS];
+  const int nf = fields_of(sim, f);
+  unsigned mask = 0;
+  for (int k = 0; k < nf; ++k)
+    if (*f[k].a && f[k].nc > 0) mask |= 1u << k;
+  const int nsets = sim->sets ? sim->sets->n : 0;
+  const int len = record_len(f, nf, mask, nsets);
+  /* counts and masks first: [points, field mask, sets] */
+  int hs[2][3] = {{nout[0], (int)mask, nsets}, {nout[1], (int)mask, nsets}}, hr[2][3] = {{0}};
+  MPI_Request req[4];
+  MPI_Irecv(hr[0], 3, MPI_INT, lower(dd), TAG_MIGRATE_N, dd->comm, &req[0]);
+  MPI_Irecv(hr[1], 3, MPI_INT, upper(dd), TAG_MIGRATE_N, dd->comm, &req[1]);
+  MPI_Isend(hs[0], 3, MPI_INT, lower(dd), TAG_MIGRATE_N, dd->comm, &req[2]);
+  MPI_Isend(hs[1], 3, MPI_INT, upper(dd), TAG_MIGRATE_N, dd->comm, &req[3]);
+  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  size_t rlen[2];
+  for (int s = 0; s < 2; ++s) {
+    rlen[s] = (size_t)hr[s][0] * (size_t)record_len(f, nf, (unsigned)hr[s][1], hr[s][2]);
+    if (hr[s][0] > 0 && hr[s][2] != nsets && !err)
+      err = MPMC_ERROR(ctx, MPMC_ERR_STATE,
+                       "migration: rank %d has %d particle sets, its neighbour %d: add sets on "
+                       "every rank alike", me, nsets, hr[s][2]);
+  }
+  /* set membership of this rank's points, one flag array per set */
+  int *member = NULL;
+  if (nsets > 0 && (nout[0] || nout[1])) {
+    member = calloc((size_t)nsets * (size_t)(n > 0 ? n : 1), sizeof(int));
+    if (!member && !err) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
+    for (int k = 0; k < nsets && member; ++k) {
+      const mpmc_set *st = &sim->sets->s[k];
+      for (int j = 0; j < st->n; ++j)
+        if (st->idx[j] >= 0 && st->idx[j] < n) member[(size_t)k * n + st->idx[j]] = 1;
+    }
+  }
+  const size_t slen[2] = {(size_t)nout[0] * (size_t)len, (size_t)nout[1] * (size_t)len};
+  double *sb = malloc(sizeof(double) * (slen[0] + slen[1] + rlen[0] + rlen[1] + 1));
+  if (!sb && !err) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory for the messages");
+  err = mpmc_dd_agree(sim, err);
+  if (err) {
+    free(dest);
+    free(member);
+    free(sb);
+    return err;
+  }
+  double *out[2] = {sb, sb + slen[0]}, *in[2] = {sb + slen[0] + slen[1], sb + slen[0] + slen[1] + rlen[0]};
+  size_t pos[2] = {0, 0};
+  for (int q = 0; q < n; ++q) {
+    if (!dest[q]) continue;
+    const int s = dest[q] > 0;
+    double *o = out[s] + pos[s];
+    int k = 0;
+    o[k++] = p->mat[q];
+    o[k++] = p->id ? p->id[q] : q;
+    for (int j = 0; j < nsets; ++j) o[k++] = member[(size_t)j * n + q];
+    for (int i = 0; i < nf; ++i)
+      if (mask >> i & 1u)
+        for (int c = 0; c < f[i].nc; ++c) o[k++] = (*f[i].a)[(size_t)q * f[i].nc + c];
+    pos[s] += (size_t)len;
+  }
+  MPI_Irecv(in[0], (int)rlen[0], MPI_DOUBLE, lower(dd), TAG_MIGRATE, dd->comm, &req[0]);
+  MPI_Irecv(in[1], (int)rlen[1], MPI_DOUBLE, upper(dd), TAG_MIGRATE, dd->comm, &req[1]);
+  MPI_Isend(out[0], (int)slen[0], MPI_DOUBLE, lower(dd), TAG_MIGRATE, dd->comm, &req[2]);
+  MPI_Isend(out[1], (int)slen[1], MPI_DOUBLE, upper(dd), TAG_MIGRATE, dd->comm, &req[3]);
+  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+
+  /* the staying points close ranks, in order; sets renumbered */
+  int m = 0;
+  if (nout[0] || nout[1]) {
+    int *map = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    if (!map) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
+    for (int q = 0; q < n && map; ++q) map[q] = dest[q] ? -1 : m++;
+    if (map) {
+      for (int i = 0; i < nf; ++i) {
+        if (!*f[i].a || f[i].nc <= 0) continue;
+        double *a = *f[i].a;
+        const size_t nc = (size_t)f[i].nc;
+        for (int q = 0; q < n; ++q)
+          if (map[q] >= 0 && map[q] != q) memcpy(a + (size_t)map[q] * nc, a + (size_t)q * nc, nc * sizeof(double));
+      }
+      for (int q = 0; q < n; ++q)
+        if (map[q] >= 0) {
+          p->mat[map[q]] = p->mat[q];
+          if (p->id) p->id[map[q]] = p->id[q];
+        }
+      for (int k = 0; k < nsets; ++k) {
+        mpmc_set *st = &sim->sets->s[k];
+        int j2 = 0;
+        for (int j = 0; j < st->n; ++j)
+          if (st->idx[j] >= 0 && st->idx[j] < n && map[st->idx[j]] >= 0) st->idx[j2++] = map[st->idx[j]];
+        st->n = j2;
+      }
+      free(map);
+    }
+  } else {
+    m = n;
+  }
+  p->n = m;
+  /* the arrivals, the lower neighbour's first */
+  const int nin = hr[0][0] + hr[1][0];
+  if (!err && nin > 0) {
+    int cap = p->cap ? p->cap : 64;
+    while (cap < m + nin) cap *= 2;
+    err = mpmc_particles_reserve(ctx, p, cap);
+    for (int i = 0; i < nf && !err; ++i)
+      if ((((unsigned)hr[0][1] | (unsigned)hr[1][1]) >> i & 1u)) err = ensure_field(sim, &f[i]);
+    if (!err && !p->id) {
+      p->id = malloc(sizeof(int) * (size_t)p->cap);
+      if (!p->id) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory for the ids");
+      for (int q = 0; q < m && p->id; ++q) p->id[q] = q;
+    }
+    for (int k = 0; k < nsets && !err; ++k) { /* room for every arrival in every set */
+      mpmc_set *st = &sim->sets->s[k];
+      int *idx = realloc(st->idx, sizeof(int) * (size_t)(st->n + nin));
+      if (!idx) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory for the sets");
+      else st->idx = idx;
+    }
+    for (int s = 0; s < 2 && !err; ++s) {
+      const unsigned msk = (unsigned)hr[s][1];
+      const int rl = record_len(f, nf, msk, nsets);
+      for (int j = 0; j < hr[s][0]; ++j) {
+        const double *o = in[s] + (size_t)j * (size_t)rl;
+        const int q = p->n++;
+        int k = 0;
+        p->mat[q] = (int)o[k++];
+        p->id[q] = (int)o[k++];
+        for (int t = 0; t < nsets; ++t)
+          if (o[k++] != 0.0) {
+            mpmc_set *st = &sim->sets->s[t];
+            st->idx[st->n++] = q;
+          }
+        for (int i = 0; i < nf; ++i) {
+          if (!*f[i].a || f[i].nc <= 0) continue;
+          double *a = *f[i].a + (size_t)q * f[i].nc;
+          if (msk >> i & 1u) {
+            for (int c = 0; c < f[i].nc; ++c) a[c] = o[k++];
+          } else {
+            for (int c = 0; c < f[i].nc; ++c) a[c] = isnan(f[i].fill) ? (c < 3) : f[i].fill;
+          }
+        }
+      }
+    }
+  }
+  free(dest);
+  free(member);
+  free(sb);
+  if (nin > 0 || nout[0] || nout[1]) {
+    sim->order_ident = 0;
+    sim->v2max_ok = 0; /* the stability limit takes its pass over v (stability.c) */
+  }
+  return mpmc_dd_agree(sim, err);
+}
+
+#endif /* MPMC_HAVE_MPI */
