@@ -78,9 +78,10 @@ static int open_trial(mpmc_context ctx, const char *base, const wf_scene *sc, do
   return e;
 }
 
-/* One trial: the stage's time at factor F from the base state. */
+/* One trial: the stage's time at factor F from the base state.  A failing trial leaves its
+ * final state in the CSV mech (when not NULL; the mechanism, fos_mechanism.csv). */
 static int run_trial(mpmc_context ctx, const char *base, const wf_scene *sc, const wf_stage *s, double F,
-                     wf_fos_trial *t, char *msg, size_t len) {
+                     const char *mech, wf_fos_trial *t, char *msg, size_t len) {
   const double w0 = wf_now();
   mpmc_sim sim = NULL;
   double *xs = NULL;
@@ -121,6 +122,7 @@ static int run_trial(mpmc_context ctx, const char *base, const wf_scene *sc, con
     t->steps = steps;
   }
   t->wall_seconds = wf_now() - w0;
+  if (!e && t->failed && mech) wf_fos_mechanism_write(sim, sc, xs, mech); /* no file: no mechanism plot */
   free(xs);
   mpmc_sim_destroy(&sim);
   return e;
@@ -132,6 +134,10 @@ typedef struct {
   int e;
   char msg[1024];
 } trial_report;
+
+static void mech_path(char *buf, size_t n, const char *outdir, int trial) {
+  snprintf(buf, n, "%s/fos_trial_%d.csv", outdir, trial);
+}
 
 /* read exactly n bytes (fewer: the writer ended first) */
 static size_t read_all(int fd, void *buf, size_t n) {
@@ -145,11 +151,15 @@ static size_t read_all(int fd, void *buf, size_t n) {
   return got;
 }
 
-/* The k trials F[0..k) into t[0..k): in this process when k = 1, else at once in k child
- * processes.  0, or the first error (by factor) with msg naming the factor. */
-static int run_round(mpmc_context ctx, const char *base, const wf_scene *sc, const wf_stage *s, const double *F,
-                     int k, wf_fos_trial *t, char *msg, size_t len) {
-  if (k == 1) return run_trial(ctx, base, sc, s, F[0], &t[0], msg, len);
+/* The k trials F[0..k) into t[0..k), trial numbers first + j: in this process when k = 1, else
+ * at once in k child processes.  0, or the first error (by factor) with msg naming the factor. */
+static int run_round(mpmc_context ctx, const char *base, const wf_scene *sc, const wf_stage *s, const char *outdir,
+                     const double *F, int k, int first, wf_fos_trial *t, char *msg, size_t len) {
+  char mech[WF_PATH + 32];
+  if (k == 1) {
+    mech_path(mech, sizeof mech, outdir, first);
+    return run_trial(ctx, base, sc, s, F[0], mech, &t[0], msg, len);
+  }
   pid_t pid[WF_FOS_MAX_JOBS];
   int fd[WF_FOS_MAX_JOBS], started = 0, e = 0;
   fflush(NULL); /* nothing buffered twice (a child leaves by _exit, which does not flush) */
@@ -175,7 +185,8 @@ static int run_round(mpmc_context ctx, const char *base, const wf_scene *sc, con
       for (int i = 0; i < started; ++i) close(fd[i]);
       trial_report r;
       memset(&r, 0, sizeof r);
-      r.e = run_trial(ctx, base, sc, s, F[j], &r.t, r.msg, sizeof r.msg);
+      mech_path(mech, sizeof mech, outdir, first + j);
+      r.e = run_trial(ctx, base, sc, s, F[j], mech, &r.t, r.msg, sizeof r.msg);
       const char *b = (const char *)&r;
       size_t left = sizeof r;
       while (left > 0) {
@@ -224,13 +235,19 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
                   size_t len) {
   const wf_stage *s = &sc->stages[stage];
   const wf_fos *f = &s->fos;
-  const int jobs = f->jobs < 1 ? 1 : f->jobs > WF_FOS_MAX_JOBS ? WF_FOS_MAX_JOBS : f->jobs;
-  char base[WF_PATH + 32], line[512];
+  const int jobs = wf_fos_jobs(f);
+  char base[WF_PATH + 32], path[WF_PATH + 32], line[512];
   if (jobs > 1 && sc->threads != 1) {
     /* OpenMP's thread pool does not survive a fork; one thread per trial process anyway */
     snprintf(msg, len, "factor_of_safety.jobs = %d runs trials in processes of one thread each: set threads: 1 "
                        "(got %d)", jobs, sc->threads);
     return MPMC_ERR_ARG;
+  }
+  /* this search's pictures, not an earlier run's */
+  static const char *const old[] = {"fos_mechanism.csv", "fos_mechanism.png", "fos_trials.png", NULL};
+  for (int i = 0; old[i]; ++i) {
+    snprintf(path, sizeof path, "%s/%s", outdir, old[i]);
+    remove(path);
   }
   snprintf(base, sizeof base, "%s/fos_base.h5", outdir);
   int e = mpmc_sim_checkpoint_write(sim, base, "mpmc-workflow fos base");
@@ -264,8 +281,14 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
     }
     wf_fos_trial *t = &res->trial[res->ntrial];
     const int first = res->ntrial + 1;
-    e = run_round(ctx, base, sc, s, F, k, t, msg, len);
-    if (e) return e;
+    e = run_round(ctx, base, sc, s, outdir, F, k, first, t, msg, len);
+    if (e) {
+      for (int j = 0; j < k; ++j) {
+        mech_path(path, sizeof path, outdir, first + j);
+        remove(path);
+      }
+      return e;
+    }
     for (int j = 0; j < k; ++j) {
       snprintf(line, sizeof line,
                "factor of safety: trial %d, F = %.4f: %s (largest displacement %.4g m, limit %g m; grew %.3g "
@@ -275,15 +298,18 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
       if (say) say(data, line);
     }
     res->ntrial += k;
+    int hi_from = -1; /* the trial of this round that became hi */
     if (bracketing) {
       const wf_fos_trial *tl = !lo_ok ? &t[0] : NULL, *th = !hi_ok && k > (tl != NULL) ? &t[k - 1] : NULL;
       if (tl && tl->failed) {
         hi = lo, hi_ok = 1; /* the lower guess fails: it bounds from above, look lower */
         lo = lo / 1.5;
+        hi_from = 0;
       } else {
         if (tl) lo_ok = 1;
         if (th && th->failed) {
           hi_ok = 1;
+          hi_from = k - 1;
         } else if (th) {
           lo = hi, lo_ok = 1; /* stands: widen upwards */
           hi = hi * 1.5;
@@ -296,7 +322,19 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
       for (int j = 0; j < k && jf == k; ++j)
         if (t[j].failed) jf = j;
       for (int j = 0; j < jf; ++j) lo = F[j];
-      if (jf < k) hi = F[jf];
+      if (jf < k) hi = F[jf], hi_from = jf;
+    }
+    /* the mechanism: the final state of the trial at the smallest failing factor */
+    char mech[WF_PATH + 32];
+    snprintf(path, sizeof path, "%s/fos_mechanism.csv", outdir);
+    for (int j = 0; j < k; ++j) {
+      mech_path(mech, sizeof mech, outdir, first + j);
+      if (j == hi_from) {
+        res->mechanism = rename(mech, path) == 0;
+        if (!res->mechanism) remove(path);
+      } else {
+        remove(mech);
+      }
     }
   }
   res->lo = lo;
@@ -318,6 +356,53 @@ int wf_fos_write_csv(const char *path, const wf_fos_result *res) {
             t->max_displacement, t->growth, t->ke_ratio, t->sim_time, t->steps, t->wall_seconds);
   }
   return fclose(f) ? MPMC_ERR_IO : 0;
+}
+
+/** @brief The trials a search runs at once: factor_of_safety.jobs within [1, WF_FOS_MAX_JOBS]. */
+int wf_fos_jobs(const wf_fos *f) {
+  return f->jobs < 1 ? 1 : f->jobs > WF_FOS_MAX_JOBS ? WF_FOS_MAX_JOBS : f->jobs;
+}
+
+/**
+ * @brief The trials of a finished search back from its fos_trials.csv (`mpmc resume` after the
+ *        search): the bracket from the largest standing and the smallest failing factor.
+ *        0, MPMC_ERR_IO (no file) or MPMC_ERR_FORMAT (a row that does not parse; msg names it).
+ */
+int wf_fos_read_csv(const char *path, wf_fos_result *res, char *msg, size_t len) {
+  FILE *f = fopen(path, "r");
+  if (!f) {
+    snprintf(msg, len, "cannot read %s: %s", path, strerror(errno));
+    return MPMC_ERR_IO;
+  }
+  char line[512], verdict[16];
+  int row = 0, e = 0;
+  res->ntrial = 0;
+  res->lo = -HUGE_VAL;
+  res->hi = HUGE_VAL;
+  while (!e && fgets(line, sizeof line, f)) {
+    if (++row == 1) continue; /* the header */
+    wf_fos_trial t = {0};
+    int k = 0;
+    if (sscanf(line, "%d,%lf,%15[a-z],%lf,%lf,%lf,%lf,%ld,%lf", &k, &t.factor, verdict, &t.max_displacement,
+               &t.growth, &t.ke_ratio, &t.sim_time, &t.steps, &t.wall_seconds) != 9 ||
+        (strcmp(verdict, "fails") && strcmp(verdict, "stands")) ||
+        res->ntrial == (int)(sizeof res->trial / sizeof res->trial[0])) {
+      snprintf(msg, len, "%s:%d: not a trial row (trial,factor,verdict,...)", path, row);
+      e = MPMC_ERR_FORMAT;
+      break;
+    }
+    t.failed = !strcmp(verdict, "fails");
+    if (t.failed && t.factor < res->hi) res->hi = t.factor;
+    if (!t.failed && t.factor > res->lo) res->lo = t.factor;
+    res->trial[res->ntrial++] = t;
+  }
+  fclose(f);
+  if (!e && (res->ntrial == 0 || !isfinite(res->lo) || !isfinite(res->hi))) {
+    snprintf(msg, len, "%s: no bracket (a standing and a failing trial)", path);
+    e = MPMC_ERR_FORMAT;
+  }
+  res->found = !e;
+  return e;
 }
 
 void wf_fos_json(FILE *f, const wf_fos_result *res) {

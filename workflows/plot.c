@@ -208,3 +208,127 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
   if (sc->metrics.enabled[WF_METRIC_BEARING]) plot_bearing(g, sc);
   return wf_gnuplot_close(g, outdir, "plots.log", warn, len);
 }
+
+/* ---- the factor-of-safety search's plots (fos.c) ---------------------------------------- */
+
+/**
+ * @brief The state at a trial's end in final_state.csv's columns, the displacement measured
+ *        from xs (positions by point id at the trial's start), into path.  0, or -1.
+ */
+int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const double *xs, const char *path) {
+  const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
+  int hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
+  if (hx == vy) hx = vy == 0 ? 1 : 0;
+  int np = 0;
+  double *x, *sig, *eps = NULL, *region = NULL, *pw = NULL;
+  const int *ids;
+  if (mpmc_sim_get_num_particles(sim, &np) || mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
+      mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL) || mpmc_sim_get_particle_ids(sim, &ids))
+    return -1;
+  int plastic = 0;
+  for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
+  if (plastic && mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
+  if (mpmc_sim_get_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
+  if ((!sc->water.n && !sc->water.has_plane) || mpmc_sim_get_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
+  const int d = sc->dim, dz = 3 - hx - vy;
+  depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
+  FILE *f = order ? fopen(path, "w") : NULL;
+  if (!f) {
+    free(order);
+    return -1;
+  }
+  for (int q = 0; q < np; ++q) {
+    order[q].q = q;
+    order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
+  }
+  if (d == 3) qsort(order, (size_t)np, sizeof *order, by_depth);
+  fprintf(f, "%s%s%s\n", d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz" : "x,y,mean_stress,eps_p,ux,uy",
+          region ? ",region" : "", pw ? ",pore_pressure" : "");
+  for (int k = 0; k < np; ++k) {
+    const size_t q = (size_t)order[k].q, id = (size_t)ids[q];
+    const double p = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3.0;
+    for (int a = 0; a < d; ++a) fprintf(f, "%.7g,", x[q * d + a]);
+    fprintf(f, "%.7g,%.7g", p, eps ? eps[q] : 0.0);
+    for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - xs[id * d + a]);
+    if (region) fprintf(f, ",%d", (int)region[q]);
+    if (pw) fprintf(f, ",%.7g", pw[q]);
+    fputc('\n', f);
+  }
+  free(order);
+  return fclose(f) ? -1 : 0;
+}
+
+/**
+ * @brief fos_trials.png (each trial's largest displacement against F, the limit, the final
+ *        bracket) and, when res->mechanism, fos_mechanism.png (|u| since the trial's start and
+ *        eps_p at the end of the trial at the smallest failing factor) into outdir; gnuplot's
+ *        output in outdir/fos_plots.log.  0, or 1 with a warning.
+ */
+int wf_fos_plots(const wf_scene *sc, int stage, const wf_fos_result *res, const char *outdir, char *warn,
+                 size_t len) {
+  const wf_fos *fs = &sc->stages[stage].fos;
+  FILE *g = wf_gnuplot_open(outdir, "fos_plots.log", "factor-of-safety plots",
+                            "no PNG plots of the search, the data is in fos_trials.csv and fos_mechanism.csv", warn,
+                            len);
+  if (!g) return 1;
+  const double fos = 0.5 * (res->lo + res->hi);
+  /* F against the criterion */
+  wf_gnuplot_terminal(g, 1200, 800, 12);
+  fprintf(g, "set output 'fos_trials.png'\nset title '%s: factor-of-safety search, %d trials (%d at once)%s' "
+             "noenhanced\n",
+          sc->name, res->ntrial, res->jobs, res->found ? "" : ", no bracket");
+  fprintf(g, "set xlabel 'strength reduction factor F'\nset ylabel 'largest displacement in the trial [m]'\n"
+             "set logscale y\nset grid\nset key bottom right box opaque noenhanced\n");
+  fprintf(g, "set object 1 rectangle from %.9g, graph 0 to %.9g, graph 1 fillcolor rgb '#fdae61' "
+             "fillstyle solid 0.6 noborder behind\n",
+          res->lo, res->hi);
+  fprintf(g, "set arrow 1 from %.9g, graph 0 to %.9g, graph 1 nohead lw 1 lc rgb '#f46d43'\n"
+             "set arrow 2 from %.9g, graph 0 to %.9g, graph 1 nohead lw 1 lc rgb '#f46d43'\n",
+          res->lo, res->lo, res->hi, res->hi);
+  fprintf(g, "plot 'fos_trials.csv' skip 1 using 2:(strcol(3) eq 'stands' && $4 > 0 ? $4 : NaN) with points "
+             "pt 7 ps 1.6 lc rgb '#1a9850' title 'stands', "
+             "'' skip 1 using 2:(strcol(3) eq 'fails' && $4 > 0 ? $4 : NaN) with points pt 5 ps 1.6 "
+             "lc rgb '#d73027' title 'fails', "
+             "%.9g with lines dt 2 lw 2 lc rgb 'black' title 'displacement limit %g m', "
+             "NaN with boxes fillcolor rgb '#fdae61' fillstyle solid 0.6 noborder title '%s [%.4g, %.4g]: F = %.4g'\n",
+          fs->displacement_limit, fs->displacement_limit, res->found ? "final bracket" : "last bracket", res->lo,
+          res->hi, fos);
+  fprintf(g, "unset object 1\nunset arrow 1\nunset arrow 2\nunset logscale y\nset key default\n");
+  if (res->mechanism) {
+    double t = 0.0;
+    for (int i = 0; i < res->ntrial; ++i)
+      if (res->trial[i].factor == res->hi) t = res->trial[i].sim_time;
+    const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
+    int hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
+    if (hx == vy) hx = vy == 0 ? 1 : 0;
+    const int d = sc->dim, cx = hx + 1, cy = vy + 1, ce = d + 2, cu = d + 3;
+    const char *ax = "xyz", *water = "";
+    if (sc->water.n && hx == 0) {
+      const wf_water *wt = &sc->water;
+      fprintf(g, "$water << EOD\n%.9g,%.9g\n", sc->lo[0], wt->xh[1]);
+      for (int k = 0; k < wt->n; ++k) fprintf(g, "%.9g,%.9g\n", wt->xh[2 * k], wt->xh[2 * k + 1]);
+      fprintf(g, "%.9g,%.9g\nEOD\n", sc->hi[0], wt->xh[2 * wt->n - 1]);
+      water = ", $water using 1:2 with lines lw 2 lc rgb '#1f78b4' title 'water table'";
+    }
+    char umag[96];
+    if (d == 3)
+      snprintf(umag, sizeof umag, "(sqrt($%d**2 + $%d**2 + $%d**2))", cu, cu + 1, cu + 2);
+    else
+      snprintf(umag, sizeof umag, "(sqrt($%d**2 + $%d**2))", cu, cu + 1);
+    wf_gnuplot_terminal(g, 1400, 1000, 12);
+    fprintf(g, "set output 'fos_mechanism.png'\nset size ratio -1\nset grid\nset xlabel '%c [m]'\nset ylabel '%c [m]'\n"
+               "set cbrange [0:*]\n",
+            ax[hx], ax[vy]);
+    fprintf(g, "set multiplot layout 2,1 title '%s%s: the mechanism, at the end (t = %.3g s) of the trial at the "
+               "smallest failing factor F = %.4g' noenhanced\n",
+            sc->name, d == 3 ? " (side view)" : "", t, res->hi);
+    fprintf(g, "set title 'displacement since the trial start |u| [m]'\nset cblabel '|u| [m]'\n"
+               "plot 'fos_mechanism.csv' skip 1 using %d:%d:%s with points pt 7 ps 0.35 lc palette notitle%s\n",
+            cx, cy, umag, water);
+    fprintf(g, "set title 'equivalent plastic strain'\nset cblabel 'eps_p' noenhanced\n"
+               "plot 'fos_mechanism.csv' skip 1 using %d:%d:%d with points pt 7 ps 0.35 lc palette notitle%s\n",
+            cx, cy, ce, water);
+    fprintf(g, "unset multiplot\nset cbrange [*:*]\n");
+  }
+  return wf_gnuplot_close(g, outdir, "fos_plots.log", warn, len);
+}

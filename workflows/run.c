@@ -182,6 +182,7 @@ static int run_output(const char *name) {
                                       "snapshots_resumed.h5", "snapshots_resumed.xdmf", "checkpoint.h5.tmp",
                                       "final_state.csv", "final_mean_stress.png", "final_eps_p.png", "series.png",
                                       "bearing.png", "plots.log", "snapshot_plots.log", "fos_trials.csv", "fos_base.h5",
+                                      "fos_mechanism.csv", "fos_mechanism.png", "fos_trials.png", "fos_plots.log",
                                       NULL};
   for (int i = 0; files[i]; ++i) {
     const size_t l = strlen(files[i]);
@@ -292,7 +293,7 @@ static void log_plan(const wf_run *w) {
     damping |= sc->stages[i].damping > 0;
     tractions |= sc->stages[i].ntractions > 0;
     walls += sc->stages[i].nwalls;
-    srf |= sc->stages[i].strength_reduction > 0;
+    srf |= sc->stages[i].strength_reduction > 0 || sc->stages[i].has_fos;
   }
   say(w, "scene %s (%s): %dD%s, grid %g m cells, basis %s, %d material points", sc->name, sc->path,
       sc->dim, sc->dim == 2 ? " plane strain" : "", sc->h, wf_basis_name(sc->basis), np);
@@ -666,6 +667,10 @@ static int run_fos(wf_run *w, int i) {
   char path[WF_PATH];
   out_path(w, "fos_trials.csv", path, sizeof path);
   if (wf_fos_write_csv(path, w->fos)) return fail(w, MPMC_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+  if (w->sc.plots) {
+    char warn[WF_MSG] = "";
+    if (wf_fos_plots(&w->sc, i, w->fos, w->out, warn, sizeof warn)) say(w, "warning: plots: %s", warn);
+  }
   if (!w->fos->found) return fail(w, MPMC_ERR_NUMERIC, "stage '%s': %s", s->name, msg);
   const double F = w->fos->hi;
   WF_TRY(w, mpmc_sim_set_strength_reduction(w->sim, -1, F), "stages.%d: the first failing factor", i);
@@ -711,7 +716,6 @@ static int run_all(wf_run *w, int first_stage, const stage_clock *from, long ste
     if (!(i == first_stage && t_stage > 0)) w->ke_below = -1.0; /* else restored from the checkpoint */
     if (w->sc.stages[i].has_fos) {
       if (run_fos(w, i)) return -1;
-      if (w->fos_only) break; /* `mpmc fos`: the answer, without the stages after */
     } else if (run_stage(w, i, i == first_stage ? from : NULL, &steps, &pr)) {
       return -1;
     }
@@ -719,12 +723,15 @@ static int run_all(wf_run *w, int first_stage, const stage_clock *from, long ste
     /* at the start of the next stage; after the last one, the finished run (stage = nstage),
      * which `mpmc resume` continues once the scene has another stage: that one only warns
      * when it cannot be written, the run itself is done and its outputs follow */
+    const int last = i + 1 == w->sc.nstage || (w->fos_only && w->sc.stages[i].has_fos);
     if (checkpoint(w, i + 1, NULL, steps)) {
-      if (i + 1 < w->sc.nstage) return -1;
+      if (!last) return -1;
       say(w, "warning: the final checkpoint: %s (the run is complete; it cannot be extended by `mpmc resume`)",
           mpmc_context_last_error(w->ctx));
     }
 #endif
+    /* `mpmc fos`: the answer, without the stages after (`mpmc resume` runs them) */
+    if (w->fos_only && w->sc.stages[i].has_fos) break;
   }
   return 0;
 }
@@ -971,6 +978,22 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     for (int i = 0; i < ndone; ++i) {
       w.rec[i] = done[i];
       snprintf(w.rec[i].name, sizeof w.rec[i].name, "%s", w.sc.stages[i].name);
+    }
+    /* a finished search is not run again: its answer comes back from fos_trials.csv */
+    for (int i = 0; i < ndone && !err; ++i) {
+      if (strcmp(done[i].reason, "fos") || !w.sc.stages[i].has_fos) continue;
+      char trials[WF_PATH], msg[WF_MSG];
+      out_path(&w, "fos_trials.csv", trials, sizeof trials);
+      if (!w.fos && !(w.fos = calloc(1, sizeof *w.fos))) {
+        err = fail(&w, MPMC_ERR_MEMORY, "resume: factor of safety");
+      } else if (wf_fos_read_csv(trials, w.fos, msg, sizeof msg)) {
+        err = fail(&w, MPMC_ERR_FORMAT, "resume: stage '%s' (a finished factor-of-safety search): %s",
+                   w.sc.stages[i].name, msg);
+      } else {
+        w.fos->jobs = wf_fos_jobs(&w.sc.stages[i].fos);
+        out_path(&w, "fos_mechanism.csv", trials, sizeof trials);
+        w.fos->mechanism = access(trials, R_OK) == 0;
+      }
     }
     w.sim = sim;
     w.ckpt_ok = 1; /* the checkpoint resumed from is the last good state until the next one */

@@ -247,6 +247,7 @@ typedef struct {
   wf_fos_trial trial[64];
   double lo, hi;             /* the final bracket: lo stood, hi failed                  */
   int found;                 /* 1: bracketed to the tolerance                           */
+  int mechanism;             /* 1: outdir/fos_mechanism.csv holds the trial at hi's end  */
   int jobs;                  /* trials run at once                                      */
 } wf_fos_result;
 /* The search of stage s from the state sim (set up for the stage), which it leaves as it is:
@@ -258,6 +259,18 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
 /* fos_trials.csv and summary.json's fos fields (report.c) */
 int wf_fos_write_csv(const char *path, const wf_fos_result *res);
 void wf_fos_json(FILE *f, const wf_fos_result *res);
+/* The trials of a finished search read back from its fos_trials.csv (resume); 0, or an error
+ * with msg naming the file and row. */
+int wf_fos_read_csv(const char *path, wf_fos_result *res, char *msg, size_t len);
+/* factor_of_safety.jobs within [1, WF_FOS_MAX_JOBS] */
+int wf_fos_jobs(const wf_fos *f);
+/* The state at a trial's end as a CSV in final_state.csv's columns, the displacement since
+ * the trial's start (xs: positions by point id) (plot.c); 0, or -1. */
+int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const double *xs, const char *path);
+/* fos_mechanism.png (from fos_mechanism.csv, when res->mechanism) and fos_trials.png (from
+ * fos_trials.csv) in outdir; 0, or 1 with a warning (gnuplot missing or failed). */
+int wf_fos_plots(const wf_scene *sc, int stage, const wf_fos_result *res, const char *outdir, char *warn,
+                 size_t len);
 FILE *wf_series_open(const char *path, const wf_scene *sc, int append, char *msg, size_t len);
 int wf_series_row(FILE *f, mpmc_sim sim, const wf_scene *sc, int stage, long step, double dt, double ke,
                   double ratio);
