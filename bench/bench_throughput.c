@@ -3,7 +3,7 @@
  *   column - a 3D column collapse: 2 x 0.5 x 1 m domain, h = 0.025 m, a 0.5 m
  *            cube of J2 soil with 2x2x2 points per cell (64,000 points), gravity
  * on 1 and 2 threads.  Usage: bench_throughput [steps] [scale] [case] [threads] [shuffle] [sort];
- * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-9,
+ * scale multiplies the number of cells per axis of the column (1 = 64,000 points); case (0-12,
  * the rows of the table; -1 all) and threads (1 or 2; 0 both) narrow the run for profiling,
  * e.g. under callgrind; shuffle = 1 stores the points in random order (what sorting the
  * particle arrays by cell undoes: the cost of lost locality); sort = N sorts the points by cell
@@ -232,6 +232,8 @@ int main(int argc, char **argv) {
       {1, MPMC_BASIS_LINEAR, on, 1},
       /* Algorithm 1 as published */
       {1, MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, 1},
+      /* cubic B-splines, without and with F-bar (callgrind's counts per case) */
+      {1, MPMC_BASIS_BSPLINE3, 0, 1}, {1, MPMC_BASIS_BSPLINE3, on, 1},
   };
   printf("%-7s %-9s %-5s %-10s %9s %14s %14s %8s %7s\n", "scene", "basis", "fbar", "material",
          "points", "1 thread [M/s]", "2 threads [M/s]", "speedup", "B/point");

@@ -93,7 +93,6 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
    * 16 SSE registers: the first sweep then takes the velocity half (v_pic, L) and the second
    * the increment half (dv).  The fused F-bar scatter, which needs dJ, has a loop of its own. */
   const int SPLIT = NC > 1, N1 = SPLIT ? NC : NV;
-  const double travel = FB & 4 ? mpmc_anchor_travel(DIM, p, q, dt * g->inv_h) : 0.0;
   mpmc_vd A[MPMC_NV], B0[MPMC_NC], B1[MPMC_NC], B2[MPMC_NC];
   for (int k = 0; k < NV; ++k) A[k] = zero;
   for (int k = 0; k < NC; ++k) B0[k] = B1[k] = B2[k] = zero;
@@ -157,9 +156,20 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   int ok = dJ > 0.0 && isfinite(dJ);
   mpmc_v2d vv = {0.0, 0.0};
   const int FS = FB & 3; /* the scatter's form */
+  double *v = p->v + qd, vn[3] = {0.0, 0.0, 0.0}; /* v^n */
   if (FB) {
     const double Vn = p->vol0[q] * Jn;
     const double jd = p->Jbar[q] * dJ; /* kept for the gather (fbar.c) */
+    double travel = 0.0; /* the anchored form's |v^n|_1 dt / h (transfer.h, mpmc_anchor) */
+    if (FB & 4) { /* v^n loaded here once, for the travel and the velocity's update below
+                   * (read on its own ahead of the gather, the travel took 17 instructions a
+                   * point; moved with the scatter after the update, it cost the gather's
+                   * sums registers: 8 instructions more) */
+      for (int a = 0; a < DIM; ++a) vn[a] = v[a];
+      double s = fabs(vn[0]) + fabs(vn[1]);
+      if (DIM == 3) s += fabs(vn[2]);
+      travel = s * (dt * g->inv_h);
+    }
     vv = (mpmc_v2d){Vn, Vn * mpmc_fbar_j(FB & 4, sim->fbar, p, q, dJ, jd, travel)};
     if (p->Jp) vv[1] /= p->Jp[q]; /* the volume change that is not plastic (fbar.c) */
     p->Jbar[q] = jd;
@@ -194,11 +204,10 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
     vpic[i] = A[sv / MPMC_VW][sv % MPMC_VW];
     dv[i] = A[sf / MPMC_VW][sf % MPMC_VW];
   }
-  double *v = p->v + qd;
   const double eta = c->eta, pic = 1.0 - eta; /* in registers: v and xold might alias c */
   double v2 = 0.0; /* |v|^2 summed as stability.c's pass sums it */
   for (int a = 0; a < DIM; ++a) {
-    const double va = eta * (v[a] + dv[a]) + pic * vpic[a];
+    const double va = eta * ((FB & 4 ? vn[a] : v[a]) + dv[a]) + pic * vpic[a];
     v[a] = va;
     v2 += va * va;
     const double x0 = p->x[qd + a], xa = x0 + dt * vpic[a];

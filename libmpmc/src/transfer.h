@@ -216,20 +216,11 @@ MPMC_ALWAYS_INLINE double mpmc_det_dim(const int DIM, const double *F) {
  * (docs/theory.md). */
 #define MPMC_ANCHOR_STRAIN 1e-2
 
-/* The travel term of the anchored form's share, |v^n|_1 dt / h, for point q (its velocity
- * before G2P updates it, the sum of its components' magnitudes: a square root a point cost
- * G2P 4 %); read ahead of the gather, off the scatter's path. */
-MPMC_ALWAYS_INLINE double mpmc_anchor_travel(const int DIM, const mpmc_particles *p, int q,
-                                             double dt_over_h) {
-  const double *v = p->v + (size_t)q * DIM;
-  double s = fabs(v[0]) + fabs(v[1]);
-  if (DIM == 3) s += fabs(v[2]);
-  return s * dt_over_h;
-}
-
 /* F-bar's anchored form (fbar.c): point q's anchored Jacobian Janc (J times the Jbar / J it
  * was last anchored to) carried by this step's dJ and re-anchored to Algorithm 1's
- * jd = Jbar^n dJ by the share alpha of the step (travel: mpmc_anchor_travel):
+ * jd = Jbar^n dJ by the share alpha of the step (travel = |v^n|_1 dt / h, the sum of the
+ * magnitudes of the point's velocity components before G2P's update, which loads them once
+ * for both: g2p.c; a square root a point, the Euclidean norm, cost G2P 4 %):
  * Janc <- Janc dJ + alpha (jd - Janc dJ).  alpha = 1 is Algorithm 1 (it projects jd),
  * alpha = 0 the projection of J calibrated by the point's last anchoring.  Returns Janc, the
  * value the point scatters.  (The magnitude of the whole strain increment in place of dJ's
