@@ -162,7 +162,8 @@ module mpmc
   public :: mpmc_sim_create, mpmc_sim_destroy, mpmc_sim_get_context, mpmc_sim_get_dim, &
     mpmc_sim_set_grid, mpmc_sim_get_grid, mpmc_sim_set_basis, mpmc_sim_set_fbar, &
     mpmc_sim_get_fbar, mpmc_sim_set_flip_blend, mpmc_sim_set_gravity, mpmc_sim_set_damping, &
-    mpmc_sim_set_kinetic_damping, mpmc_sim_set_solver, mpmc_sim_set_threads, &
+    mpmc_sim_set_kinetic_damping, mpmc_sim_set_adaptive_damping, &
+    mpmc_sim_get_adaptive_damping, mpmc_sim_set_solver, mpmc_sim_set_threads, &
     mpmc_sim_set_kernels, mpmc_sim_get_kernels, mpmc_sim_set_water_table, &
     mpmc_sim_set_water_table_plane, mpmc_sim_set_geostatic_stress
   ! MPI builds only (libmpmc/include/mpmc_mpi.h): comm is MPI's Fortran handle, the integer
@@ -377,6 +378,23 @@ module mpmc
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
       integer(c_int), value :: on
+      integer(c_int) :: ierr
+    end function
+    ! adaptive viscous damping, c = 2 zeta omega (omega estimated each step): zeta in [0, 2],
+    ! 1 critical, 0 off
+    function mpmc_sim_set_adaptive_damping(sim, zeta) &
+        bind(C, name='mpmc_sim_set_adaptive_damping') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), value :: zeta
+      integer(c_int) :: ierr
+    end function
+    ! c [1/s] the next step applies
+    function mpmc_sim_get_adaptive_damping(sim, c) &
+        bind(C, name='mpmc_sim_get_adaptive_damping') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), intent(out) :: c
       integer(c_int) :: ierr
     end function
     ! xh(2, n): (x, h) of the piezometric line, x increasing; n = 0 removes the table

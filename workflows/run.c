@@ -355,6 +355,8 @@ static void log_plan(const wf_run *w) {
                s->strength_reduction);
     if (s->damping > 0) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", damping %g", s->damping);
     if (s->kinetic_damping) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", kinetic damping");
+    if (s->adaptive_damping > 0)
+      snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", adaptive damping (zeta %g)", s->adaptive_damping);
     if (s->k0 > 0) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", geostatic stress K0 = %g", s->k0);
     if (s->nwalls) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", +%d walls", s->nwalls);
     if (s->nremove) snprintf(extra + strlen(extra), sizeof extra - strlen(extra), ", -%d walls", s->nremove);
@@ -370,6 +372,7 @@ static int stage_setup(wf_run *w, int i) {
   if (s->has_gravity) WF_TRY(w, mpmc_sim_set_gravity(sim, s->gravity), "stages.%d.gravity", i);
   WF_TRY(w, mpmc_sim_set_damping(sim, s->damping), "stages.%d.damping", i);
   WF_TRY(w, mpmc_sim_set_kinetic_damping(sim, s->kinetic_damping), "stages.%d.kinetic_damping", i);
+  WF_TRY(w, mpmc_sim_set_adaptive_damping(sim, s->adaptive_damping), "stages.%d.adaptive_damping", i);
   WF_TRY(w, mpmc_sim_set_flip_blend(sim, s->flip), "stages.%d.flip", i);
   WF_TRY(w, mpmc_sim_set_force_dt(sim, s->force_dt), "stages.%d.force_dt", i);
   int base = 0;
@@ -1019,6 +1022,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
         const wf_stage *s = &w.sc.stages[stage];
         mpmc_sim_set_damping(w.sim, s->damping);
         mpmc_sim_set_kinetic_damping(w.sim, s->kinetic_damping);
+        mpmc_sim_set_adaptive_damping(w.sim, s->adaptive_damping);
         mpmc_sim_set_flip_blend(w.sim, s->flip);
       }
       err = run_all(&w, stage, &clock, steps, setup) ? last_code(ctx) : 0;

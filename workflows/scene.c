@@ -966,7 +966,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   sc->nstage = ss->n;
   sc->stages = calloc((size_t)ss->n, sizeof *sc->stages);
   if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
-  static const char *const keys[] = {"name", "gravity", "damping", "kinetic_damping", "initial_stress", "flip", "walls", "remove_walls", "tractions",
+  static const char *const keys[] = {"name", "gravity", "damping", "kinetic_damping", "adaptive_damping", "initial_stress", "flip", "walls", "remove_walls", "tractions",
                                      "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
                                      "snapshots", "series_points", "rigid_bodies", "force_dt",
                                      "factor_of_safety", NULL};
@@ -989,6 +989,20 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     const range damp = {0, 1, 0, 1};
     if (get_num(r, n, p, "damping", 0, 0, damp, &s->damping)) return -1;
     if (get_bool(r, n, p, "kinetic_damping", 0, &s->kinetic_damping)) return -1;
+    /* the damping ratio zeta of the estimated mode; true: 0.7 (the Rayleigh quotient bounds the
+     * lowest mode from above; docs/workflows.md), false: off */
+    const wf_node *ad = map_get(n, "adaptive_damping");
+    const int adb = ad ? bool_word(ad) : -1;
+    if (adb >= 0) {
+      s->adaptive_damping = adb ? 0.7 : 0.0;
+    } else if (ad) {
+      join(full, sizeof full, p, "adaptive_damping");
+      if (parse_number(ad, &s->adaptive_damping))
+        return fail_at(r, ad, full, "expected true, false or a damping ratio in [0, 2] (got '%s')",
+                       shown(ad));
+      const range zeta = {0, 2, 0, 0};
+      if (check_range(r, ad, full, s->adaptive_damping, zeta)) return -1;
+    }
     /* absent: the scene's blend (a quasi-static stage of a FLIP scene takes a little PIC:
      * docs/theory.md) */
     if (get_num(r, n, p, "flip", 0, sc->flip, UNIT, &s->flip)) return -1;

@@ -119,6 +119,7 @@ typedef struct {
   double gravity[3];
   double damping;
   int kinetic_damping; /* velocities to zero at each peak of E_k (mpmc_sim_set_kinetic_damping) */
+  double adaptive_damping; /* damping ratio zeta of the estimated lowest mode, 0 off (mpmc_sim_set_adaptive_damping) */
   double k0;           /* initial_stress.k0: the geostatic state at the stage's start; 0: none */
   double flip; /* the stage's FLIP/PIC blend (the scene's where the stage sets none) */
   int nwalls;

@@ -186,6 +186,12 @@ int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
 int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
 int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on); /* 0 off, 1 on */
+/* Adaptive viscous damping for quasi-static stages (adaptive dynamic relaxation): nodal
+ * velocities damped by c m v with c = 2 zeta omega, omega the lowest mode's frequency
+ * estimated each step by a Rayleigh quotient over the grid; zeta in [0, 2], 1 critical,
+ * 0 off (not over MPI yet).  get: the c [1/s] the next step applies. */
+int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta);
+int mpmc_sim_get_adaptive_damping(const mpmc_sim sim, double *c);
 /* A water table: hydrostatic pore pressure p = gamma_w max(0, h - z) below the piezometric
  * elevation h (z: the last coordinate, gravity along -z).  h is a polyline of n vertices
  * xh = {x0, h0, x1, h1, ...} over x with x increasing (2D; in 3D the same across y), held

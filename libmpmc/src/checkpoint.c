@@ -66,6 +66,14 @@ static int write_config(hid_t f, const mpmc_sim sim) {
   st |= mpmc_h5_attr_write(g, "damping", H5T_NATIVE_DOUBLE, 1, &sim->damping);
   const double kd[2] = {sim->kdamp, sim->kd_ke}; /* kinetic damping: on, E_k of the last step */
   st |= mpmc_h5_attr_write(g, "kinetic_damping", H5T_NATIVE_DOUBLE, 2, kd);
+  /* adaptive damping: zeta (0: off), c, the running sums; with the last step's nodal forces
+   * the next step goes on as without the restart */
+  const double ad[4] = {sim->adr ? sim->adr_zeta : 0.0, sim->adr_c, sim->adr_sum[0],
+                        sim->adr_sum[1]};
+  st |= mpmc_h5_attr_write(g, "adaptive_damping", H5T_NATIVE_DOUBLE, 4, ad);
+  if (sim->adr && sim->adr_nf)
+    st |= mpmc_h5_dataset_write(g, "adaptive_damping_nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                                sim->grid.nn, (size_t)(1 + sim->dim), sim->adr_f);
   st |= mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &sim->time);
   st |= mpmc_h5_attr_write(g, "grid_lo", H5T_NATIVE_DOUBLE, 3, gr->lo);
   st |= mpmc_h5_attr_write(g, "grid_hi", H5T_NATIVE_DOUBLE, 3, gr->hi);
@@ -122,6 +130,35 @@ static int read_water_table(hid_t f, mpmc_sim sim) {
   return err;
 }
 
+/* Adaptive damping's node store (config dataset adaptive_damping_nodes [nn][1 + dim], the
+ * grid's nn; absent: the next step measures no quotient). */
+static int read_adaptive_nodes(hid_t f, mpmc_sim sim) {
+  hid_t g = H5Gopen2(f, "config", H5P_DEFAULT);
+  if (g < 0) return MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT, "checkpoint has no /config group");
+  int err = MPMC_SUCCESS;
+  if (exists(g, "adaptive_damping_nodes")) {
+    const size_t cols = (size_t)(1 + sim->dim), n = sim->grid.nn * cols;
+    double *a = malloc(n * sizeof *a);
+    if (!a)
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate adaptive damping's node store");
+    else if (read_dataset(g, "adaptive_damping_nodes", H5T_NATIVE_DOUBLE, sim->grid.nn, cols,
+                          a) < 0)
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT,
+                       "checkpoint /config: adaptive_damping_nodes is not [%zu][%zu] (the grid's "
+                       "nodes)",
+                       sim->grid.nn, cols);
+    if (err) {
+      free(a);
+    } else {
+      free(sim->adr_f);
+      sim->adr_f = a;
+      sim->adr_nf = n;
+    }
+  }
+  H5Gclose(g);
+  return err;
+}
+
 /* The configuration goes through the public setters, which validate it. */
 static int read_config(hid_t f, mpmc_sim sim) {
   mpmc_context ctx = sim->ctx;
@@ -151,6 +188,9 @@ static int read_config(hid_t f, mpmc_sim sim) {
   double kd[2] = {0.0, -1.0}; /* absent in files of before kinetic damping: off */
   if (H5Aexists(g, "kinetic_damping") > 0)
     st |= mpmc_h5_attr_read(g, "kinetic_damping", H5T_NATIVE_DOUBLE, 2, kd);
+  double ad[4] = {0.0, 0.0, 0.0, 0.0}; /* absent in files of before adaptive damping: off */
+  if (H5Aexists(g, "adaptive_damping") > 0)
+    st |= mpmc_h5_attr_read(g, "adaptive_damping", H5T_NATIVE_DOUBLE, 4, ad);
   int axes[2] = {-1, 0}; /* absent in files of before: no sort for an axis change until the next */
   if (H5Aexists(g, "sort_axis_slab_axis") > 0)
     st |= mpmc_h5_attr_read(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
@@ -168,9 +208,14 @@ static int read_config(hid_t f, mpmc_sim sim) {
   MPMC_CALL(mpmc_sim_set_damping(sim, damp));
   MPMC_CALL(mpmc_sim_set_kinetic_damping(sim, kd[0] != 0.0));
   sim->kd_ke = kd[1]; /* the peak test of the next step goes on as without the restart */
+  MPMC_CALL(mpmc_sim_set_adaptive_damping(sim, ad[0]));
   MPMC_CALL(read_water_table(f, sim));
   MPMC_CALL(mpmc_sim_set_time(sim, time));
   MPMC_CALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  sim->adr_c = ad[1]; /* the estimate and, below, the last step's nodal forces: the next */
+  sim->adr_sum[0] = ad[2]; /* step goes on as without the restart */
+  sim->adr_sum[1] = ad[3];
+  if (sim->adr) MPMC_CALL(read_adaptive_nodes(f, sim));
   for (int a = 0; a < sim->dim; ++a)
     MPMC_CHECK(sim->grid.hi[a] == hi[a], ctx, MPMC_ERR_FORMAT,
                "checkpoint /config: grid axis %d does not hold whole cells (hi %g, rebuilt %g)", a,

@@ -1,7 +1,7 @@
 /* Grid update (eq 9): nodal velocities from momentum and forces, gravity, local damping,
- * wall constraints, on the nodes of the active box.  Leaves the new velocity in the node
- * record's momentum slots and the increment v^{n+1} - v^n in its force slots, which is what
- * G2P's FLIP/PIC blend needs. */
+ * adaptive viscous damping, wall constraints, on the nodes of the active box.  Leaves the new
+ * velocity in the node record's momentum slots and the increment v^{n+1} - v^n in its force
+ * slots, which is what G2P's FLIP/PIC blend needs. */
 #include "mpmc_impl.h"
 
 static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
@@ -14,10 +14,19 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   /* only the active box holds mass */
   const long nrow = mpmc_grid_active_rows(g);
   const long box = (long)(g->act_hi[0] - g->act_lo[0]);
+  /* adaptive damping (damping.c): c from the last step; each node's force against its
+   * force of the last step, if it held mass then, into this row's sums */
+  const int adr = sim->adr;
+  const double cdt = sim->adr_c * dt < 2.0 ? sim->adr_c * dt : 2.0; /* (2 - c dt) >= 0 */
+  const double stamp = (double)sim->stats.steps;
+  const double ca = (2.0 - cdt) / (2.0 + cdt), cb = 2.0 * dt / (2.0 + cdt);
+  double *restrict fprev = sim->adr_f;
+  double *restrict rowsum = sim->adr_rows;
 #pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long row = 0; row < nrow; ++row) {
     size_t len;
     const size_t first = mpmc_grid_active_row(g, row, &len);
+    double num = 0.0, den = 0.0;
     for (size_t i = first; i < first + len; ++i) {
       double *restrict r = rec + i * R;
       const double m = r[0];
@@ -28,9 +37,27 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
         v0[a] = r[1 + a] * inv_m;
         f[a] = r[F + a] + m * gr[a];
       }
-      if (alpha > 0.0) mpmc_damping_apply(alpha, f, v0, DIM);
-      for (int a = 0; a < DIM; ++a) v1[a] = v0[a] + dt * f[a] * inv_m;
       const unsigned fl = fx[i];
+      if (adr) {
+        /* the Rayleigh quotient's terms over the free components: dx = v dt moved the
+         * material, df = f^n - f^{n-1} = -K dx, so omega^2 = v.(f^{n-1} - f^n) / (dt m v.v) */
+        double *restrict fp = fprev + i * (size_t)(1 + DIM);
+        const int both = fp[0] == stamp - 1.0;
+        for (int a = 0; a < DIM; ++a) {
+          if (both && !(fl & (73u << a))) {
+            num += v0[a] * (fp[1 + a] - f[a]);
+            den += dt * m * v0[a] * v0[a];
+          }
+          fp[1 + a] = f[a];
+        }
+        fp[0] = stamp;
+      }
+      if (alpha > 0.0) mpmc_damping_apply(alpha, f, v0, DIM);
+      /* adaptive damping c m v, central difference: (2 + c dt) v1 = (2 - c dt) v0 + 2 dt f/m */
+      if (adr)
+        for (int a = 0; a < DIM; ++a) v1[a] = ca * v0[a] + cb * f[a] * inv_m;
+      else
+        for (int a = 0; a < DIM; ++a) v1[a] = v0[a] + dt * f[a] * inv_m;
       if (fl) {
         for (int a = 0; a < DIM; ++a) {
           if (fl & (1u << a)) v1[a] = 0.0;
@@ -42,6 +69,10 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
         r[1 + a] = v1[a];
         r[F + a] = v1[a] - v0[a];
       }
+    }
+    if (adr) {
+      rowsum[2 * row] = num;
+      rowsum[2 * row + 1] = den;
     }
   }
 }
@@ -159,10 +190,13 @@ int MPMC_ISA(mpmc_grid_update)(mpmc_sim sim, double dt) {
     grow_box_for_mirrors(sim);
     mirror_ghosts(sim, 1);
   }
+  const long nrow = mpmc_grid_active_rows(&sim->grid);
+  if (sim->adr) MPMC_CALL(mpmc_adaptive_damping_prepare(sim, nrow));
   if (sim->dim == 2)
     update_impl(sim, 2, dt);
   else
     update_impl(sim, 3, dt);
+  if (sim->adr) mpmc_adaptive_damping_finish(sim, nrow);
   if (sim->nmirror) mirror_ghosts(sim, 0);
   return MPMC_SUCCESS;
 }

@@ -409,6 +409,16 @@ struct mpmc_sim_s {
   mpmc_water_table wt; /* hydrostatic pore pressure below a phreatic line (water.c)    */
   int kdamp;          /* kinetic damping on (damping.c, mpmc_kinetic_damping)           */
   double kd_ke;       /* kinetic damping: E_k of the points after the last step; -1: none */
+  /* adaptive viscous damping (damping.c): c = 2 zeta omega, omega^2 a Rayleigh quotient of the
+   * grid's force change over the velocity, smoothed as num / den of running sums */
+  int adr;            /* on                                                             */
+  double adr_zeta;    /* damping ratio of the estimated mode: c = 2 zeta omega          */
+  double adr_c;       /* the damping coefficient c [1/s] the next grid update applies   */
+  double adr_sum[2];  /* running sums of v.(f^{n-1} - f^n) and dt m v.v (the quotient)  */
+  double *adr_f;      /* [grid nn][1 + dim]: the step a node last held mass, its force then */
+  size_t adr_nf;      /* doubles in adr_f (0: none)                                     */
+  double *adr_rows;   /* [rows][2] the grid update's per-row sums, added in row order   */
+  size_t adr_nrows;
   int solver;
   int nthreads;
   int force_dt;
@@ -556,6 +566,10 @@ int mpmc_boundary_apply_flags(struct mpmc_sim_s *sim);
 void mpmc_damping_apply(double alpha, double *restrict f, const double *restrict v, int dim);
 /* Kinetic damping after G2P: at a peak of the points' E_k, every point velocity to zero. */
 void mpmc_kinetic_damping(struct mpmc_sim_s *sim);
+/* Adaptive damping: the node store for the step's grid update (0, or MPMC_ERR_MEMORY), and
+ * after it the new coefficient from the rows' sums (damping.c). */
+int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow);
+void mpmc_adaptive_damping_finish(struct mpmc_sim_s *sim, long nrow);
 double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor);
 void mpmc_return_map_free(struct mpmc_sim_s *sim);
 /* contact_barrier.c: fill p->cforce before P2G (only called when sim->bodies is set), the

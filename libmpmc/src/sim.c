@@ -134,6 +134,8 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   free(s->fb_scale);
   free(s->slab_start);
   free(s->slab_group);
+  free(s->adr_f);
+  free(s->adr_rows);
   free(s);
   *sim = NULL;
   return MPMC_SUCCESS;
@@ -164,6 +166,7 @@ int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h
              "the grid must be set before node sets are added");
   MPMC_CALL(mpmc_grid_setup(sim->ctx, &sim->grid, sim->dim, lo, hi, h));
   MPMC_CALL(mpmc_dd_setup(sim)); /* MPI: the ranks' slabs of this grid */
+  sim->adr_nf = 0; /* adaptive damping's node store: refilled for this grid */
   sim->prepared = 0;
   sim->walls_dirty = 1;
   return MPMC_SUCCESS;
@@ -254,6 +257,41 @@ int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on) {
   MPMC_CHECK(on == 0 || on == 1, sim->ctx, MPMC_ERR_ARG, "kinetic damping on = %d must be 0 or 1", on);
   sim->kdamp = on;
   sim->kd_ke = -1.0;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief Adaptive viscous damping (adaptive dynamic relaxation) for quasi-static stages: the
+ *        grid update damps the nodal velocities with c m v, c = 2 zeta omega, omega the
+ *        lowest mode's frequency estimated every step by a Rayleigh quotient of the nodal
+ *        force's change over the nodal velocity (damping.c).  Combines with local and
+ *        kinetic damping, but is meant alone.  Not over MPI yet.
+ * @param zeta damping ratio of the estimated mode in [0, 2]: 1 critical (Underwood's
+ *        choice), 0 off; any call restarts the estimate (no damping until the second step
+ *        has measured one)
+ */
+int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(isfinite(zeta) && zeta >= 0 && zeta <= 2, sim->ctx, MPMC_ERR_ARG,
+             "adaptive damping ratio zeta = %g must be in [0, 2] (1: critical, 0: off)", zeta);
+  MPMC_CHECK(zeta == 0 || !sim->dd, sim->ctx, MPMC_ERR_UNSUPPORTED,
+             "adaptive damping is not supported over MPI yet");
+  sim->adr = zeta > 0;
+  sim->adr_zeta = zeta;
+  sim->adr_c = 0.0;
+  sim->adr_sum[0] = sim->adr_sum[1] = 0.0;
+  for (size_t k = 0; k < sim->adr_nf; k += (size_t)(1 + sim->dim)) sim->adr_f[k] = -2.0;
+  return MPMC_SUCCESS;
+}
+
+/**
+ * @brief The adaptive damping's coefficient c = 2 zeta omega [1/s] the next step applies (0 when
+ *        it is off or has no estimate yet).
+ */
+int mpmc_sim_get_adaptive_damping(const mpmc_sim sim, double *c) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(c, sim->ctx, MPMC_ERR_ARG, "c is NULL");
+  *c = sim->adr ? sim->adr_c : 0.0;
   return MPMC_SUCCESS;
 }
 
