@@ -169,6 +169,11 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       double s = fabs(vn[0]) + fabs(vn[1]);
       if (DIM == 3) s += fabs(vn[2]);
       travel = s * (dt * g->inv_h);
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+      /* the product as it was when read ahead of the gather, in a block of its own: not fused
+       * into the share's sum (mpmc_anchor) by the contracting kernel sets, same bits */
+      __asm__("" : "+x"(travel));
+#endif
     }
     vv = (mpmc_v2d){Vn, Vn * mpmc_fbar_j(FB & 4, sim->fbar, p, q, dJ, jd, travel)};
     if (p->Jp) vv[1] /= p->Jp[q]; /* the volume change that is not plastic (fbar.c) */
