@@ -7,6 +7,7 @@
  *   bench_return_map --elastic    the elastic rows only (for callgrind)
  *   bench_return_map --stability  the stiff/extreme table of docs/stability.md
  *   bench_return_map --mc         Mohr-Coulomb / Drucker-Prager (return_mc.c) against J2
+ *   bench_return_map --mc-like    its second table alone (the like-for-like ratios)
  * The Mohr-Coulomb rows: a frictional soil (E = 25 MPa, nu = 0.3, c 20 -> 2 kPa, phi 30 -> 20
  * deg, psi 10 -> 0 deg, eta = 5) on its yield surface at eps_p in [0, 2], mean stress
  * -200..-10 kPa, random Lode angle and rotation, then the same 1e-3 increments as J2's.  The
@@ -476,6 +477,7 @@ static int stability(void) {
 int main(int argc, char **argv) {
   if (argc > 1 && !strcmp(argv[1], "--stability")) return stability();
   if (argc > 1 && !strcmp(argv[1], "--elastic")) return timing_elastic();
+  if (argc > 1 && !strcmp(argv[1], "--mc-like")) return timing_like();
   if (argc > 1 && !strcmp(argv[1], "--mc")) {
     const int err = timing_mc();
     printf("\n");

@@ -742,6 +742,45 @@ static int teardown(void **state) {
   return 0;
 }
 
+/* ---- without sigma_t the regions with the cut-off are not tried (return_mc.c,
+ * tension_regions): the same returns as with a cut-off far above the apex, which caps it
+ * there and tries them all -- Mohr-Coulomb, and Drucker-Prager where 2 eta_f / sqrt3 < 1 */
+static void test_apex_cap(void **state) {
+  (void)state;
+  int napex = 0;
+  for (int k = 0; k < 4000; ++k) {
+    mpmc_mc_param m;
+    double s[3], ep0;
+    random_case(&m, s, &ep0, k % 3 == 0, 50.0);
+    m.sigma_t = INFINITY;
+    if (m.phi_p == 0.0 || m.phi_r == 0.0) continue; /* no apex */
+    if (m.surface != MPMC_MC_MOHR_COULOMB) {
+      m.surface = MPMC_DP_COMPRESSION + k % 3;
+      const double sf = sin(fmax(m.phi_p, m.phi_r));
+      const double eta = m.surface == MPMC_DP_PLANE_STRAIN
+                             ? 3 * tan(asin(sf)) / sqrt(9 + 12 * tan(asin(sf)) * tan(asin(sf)))
+                             : 6 * sf / (sqrt(3.0) * (m.surface == MPMC_DP_COMPRESSION ? 3 - sf : 3 + sf));
+      if (!(2 * eta < sqrt(3.0) * 0.99)) continue;
+    }
+    if (k % 2) /* towards the apex and beyond */
+      for (int a = 0; a < 3; ++a) s[a] = m.c_p * (1 + 4 * urand()) + 0.2 * (s[a] - s[0]);
+    mpmc_mc_param mc = m; /* above every apex c cot(phi) of the softened material */
+    mc.sigma_t = 2 * m.c_p / tan(fmin(m.phi_p, m.phi_r));
+    double ep = ep0, ep2 = ep0, t[3], t2[3];
+    mpmc_mc_info info, info2;
+    ret(&m, MPMC_SOLVER_AUTO, s, &ep, t, &info);
+    ret(&mc, MPMC_SOLVER_AUTO, s, &ep2, t2, &info2);
+    if (info.region != info2.region)
+      fail_msg("case %d (surface %d): region %d, with the cut-off %d", k, m.surface, info.region,
+               info2.region);
+    const double sc = absmax3(s) + mc.sigma_t; /* the tolerances' scale (mpmc_mc_tolerance) */
+    expect3("stress", t, t2, sc, 1e-11);
+    TCLOSE(ep, ep2, 1e-11 * (ep2 + sc / m.G));
+    napex += info.region == MPMC_MC_APEX;
+  }
+  if (napex < 100) fail_msg("only %d apex returns", napex);
+}
+
 int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_mc_regions),       cmocka_unit_test(test_yield_after_return),
@@ -749,7 +788,7 @@ int main(void) {
       cmocka_unit_test(test_steep_softening),  cmocka_unit_test(test_objectivity),
       cmocka_unit_test(test_reduce),           cmocka_unit_test(test_triaxial),
       cmocka_unit_test(test_simple_shear),     cmocka_unit_test(test_fast_vs_eig),
-      cmocka_unit_test(test_biaxial),
+      cmocka_unit_test(test_biaxial),          cmocka_unit_test(test_apex_cap),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -78,7 +78,8 @@ static void dp_coef(int surface, double s, double c, double *eta, double *xi, do
  * the angles move by ~eta D (phi_p - phi_r), D ~ 1e-3): the addition theorem with the
  * Taylor series of d = x - x0, whose first omitted terms d^11/11!, d^12/12! are below
  * 2^-53 |d|, 2^-53 for |d| <= 0.1 (a few times cheaper than libm's sincos; the same to
- * ~1 ulp).  Farther, libm. */
+ * ~1 ulp); three terms each for |d| <= 2^-9.  Farther, libm.  Also the elastic check's
+ * material at a point's eps_p, from the nearest of mpmc_mc_pre's. */
 static inline void sin_cos_near(double x, double x0, double s0, double c0, double *s,
                                 double *c) {
   const double d = x - x0;
@@ -88,10 +89,14 @@ static inline void sin_cos_near(double x, double x0, double s0, double c0, doubl
     return;
   }
   const double d2 = d * d;
-  const double sd = /* sin d */
-      d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880 + d2 * (-1.0 / 39916800)))));
-  const double cm = /* 1 - cos d */
-      d2 * (0.5 + d2 * (-1.0 / 24 + d2 * (1.0 / 720 + d2 * (-1.0 / 40320 + d2 * (1.0 / 3628800)))));
+  double sd, cm; /* sin d, 1 - cos d */
+  if (fabs(d) <= 0x1p-9) { /* a Newton iterate's (eta D ~ 1e-3): d^7/7! < 2^-66 |d| */
+    sd = d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120));
+    cm = d2 * (0.5 + d2 * (-1.0 / 24 + d2 * (1.0 / 720)));
+  } else {
+    sd = d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880 + d2 * (-1.0 / 39916800)))));
+    cm = d2 * (0.5 + d2 * (-1.0 / 24 + d2 * (1.0 / 720 + d2 * (-1.0 / 40320 + d2 * (1.0 / 3628800)))));
+  }
   *s = s0 + (c0 * sd - s0 * cm);
   *c = c0 - (s0 * sd + c0 * cm);
 }
@@ -100,6 +105,7 @@ static inline void sin_cos_near(double x, double x0, double s0, double c0, doubl
  * ref: a material near this one (may be NULL), whose sines and cosines seed this one's. */
 static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q, const mc_mat *ref) {
   const double de = frozen ? 0.0 : -m->eta * e; /* de/d eps_p */
+  q->e = e;
   const double phi = m->phi_r + (m->phi_p - m->phi_r) * e;
   const double psi = m->psi_r + (m->psi_p - m->psi_r) * e;
   q->phi = phi;
@@ -155,10 +161,19 @@ static inline double e_of(const mpmc_mc_param *m, double ep) {
   return m->eta > 0.0 ? exp(-m->eta * ep) : 1.0;
 }
 
+/* e at eps_p^n + D: e0 exp(-eta D), the exponential of the small eta D (<= 1e-2: Newton's
+ * iterates of a return, D ~ 1e-3) by return_map.h's polynomial (within ~2 ulp of libm's,
+ * a few times cheaper), beyond it libm's exp(-eta (eps_p^n + D)) */
+static inline double sys_e(const mc_sys *S, double D) {
+  const double x = S->m->eta * D;
+  if (fabs(x) <= MPMC_RM_EXP_SMALL) return S->e0 * MPMC_RM_EXP_NEG_POLY(x);
+  return e_of(S->m, S->ep0 + D);
+}
+
 /* the material of S at eps_p^n + D: the cached one when frozen, else evaluated into *buf */
 static inline const mc_mat *sys_mat(const mc_sys *S, double D, mc_mat *buf) {
   if (S->frozen) return &S->qf;
-  mat_eval(S->m, e_of(S->m, S->ep0 + D), 0, buf, &S->q0);
+  mat_eval(S->m, sys_e(S, D), 0, buf, &S->q0);
   return buf;
 }
 
@@ -221,12 +236,10 @@ static inline double dp_f(const mc_mat *q, const double s[3]) {
 
 /* Residuals R[0..n], the Jacobian J (may be NULL) and the stress sig (may be NULL) of a
  * region of planes at y. */
-static void eval_planes(const mc_sys *S, const double *y, double *R, double J[MC_NMAX][MC_NMAX],
-                        double sig[3]) {
+static void eval_planes_q(const mc_sys *S, const mc_mat *q, const double *y, double *R,
+                          double J[MC_NMAX][MC_NMAX], double sig[3]) {
   const int n = S->n;
   const mpmc_mc_param *m = S->m;
-  mc_mat qb;
-  const mc_mat *q = sys_mat(S, y[n], &qb);
   double a[3][3], da[3][3], N[3][3], dN[3][3], k[3], dk[3], M[3] = {0, 0, 0}, dM[3] = {0, 0, 0};
   for (int j = 0; j < n; ++j) {
     plane(S->act[j], q, a[j], da[j], N[j], dN[j], &k[j], &dk[j]);
@@ -257,6 +270,11 @@ static void eval_planes(const mc_sys *S, const double *y, double *R, double J[MC
   }
   for (int i = 0; i < n; ++i) J[i][n] = dot3(da[i], s) - dk[i] - dot3(a[i], DdM);
   J[n][n] = 1.0 - c23 * dot3(u, dM);
+}
+static void eval_planes(const mc_sys *S, const double *y, double *R, double J[MC_NMAX][MC_NMAX],
+                        double sig[3]) {
+  mc_mat qb;
+  eval_planes_q(S, sys_mat(S, y[S->n], &qb), y, R, J, sig);
 }
 
 /* The same for a region with Drucker-Prager's cone (and cut-off planes).  The Jacobian is
@@ -727,7 +745,7 @@ static int single_solve(const mc_sys *S, int perfect, double *y, double s[3], mc
     double prev = INFINITY;
     int ok = 0;
     for (int it = 0; it < MC_MAX_ITERS && !ok; ++it) {
-      mat_eval(S->m, e_of(S->m, S->ep0 + y[1]), 0, q, &S->q0);
+      mat_eval(S->m, sys_e(S, y[1]), 0, q, &S->q0);
       single_eval(S, q, y, R, J, s);
       const double nr = rnorm(S, R);
       if (nr <= 1.0) {
@@ -750,6 +768,64 @@ static int single_solve(const mc_sys *S, int perfect, double *y, double s[3], mc
     q->dc = q->dphi = q->dsf = q->dcf = q->dss = q->deta = q->dxi = q->detab = q->dst = 0.0;
   }
   *R0 = R[0];
+  return admissible(S, y, s, q) ? 0 : 1;
+}
+
+/* solve_region and admissible for an edge of Mohr-Coulomb (S->n = 2 planes, S->act set) as
+ * single_solve for the main plane: solve_frozen's predictor at eps_p^n (a 2 x 2 solve, by
+ * Cramer's rule), newton's strict iteration on the 3 x 3 system with the material
+ * evaluated once per iterate, without the copies of the system that the general loop
+ * makes.  Returns 0 with y, s, q, the largest |f| in *res; 1 not admissible; 2 not solved
+ * here (the general loop tries it again, with KINSOL). */
+static int edge_solve(const mc_sys *S, int perfect, double *y, double s[3], mc_mat *q,
+                      double *res, mpmc_mc_info *info) {
+  double R[MC_NMAX], J[MC_NMAX][MC_NMAX];
+  const int iters0 = info->newton_iters;
+  for (int i = 0; i < MC_NMAX; ++i) y[i] = 0.0;
+  eval_planes_q(S, &S->q0, y, R, J, NULL);
+  const double d0 = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+  const double y0 = (-R[0] * J[1][1] + R[1] * J[0][1]) / d0;
+  const double y1 = (-R[1] * J[0][0] + R[0] * J[1][0]) / d0;
+  if (!(d0 != 0.0) || !isfinite(y0) || !isfinite(y1)) {
+    if (perfect) return 2;
+  } else {
+    y[0] = y0;
+    y[1] = y1;
+    eval_planes_q(S, &S->q0, y, R, NULL, NULL);
+    y[2] = -R[2];
+  }
+  if (perfect) {
+    *q = S->q0;
+    eval_planes_q(S, q, y, R, NULL, s);
+    if (!(rnorm(S, R) <= 1.0)) return 2;
+  } else {
+    double prev = INFINITY;
+    int ok = 0;
+    for (int it = 0; it < MC_MAX_ITERS; ++it) {
+      double dx[MC_NMAX];
+      mat_eval(S->m, sys_e(S, y[2]), 0, q, &S->q0);
+      eval_planes_q(S, q, y, R, J, s);
+      const double nr = rnorm(S, R);
+      if (nr <= 1.0) {
+        ok = 1;
+        break;
+      }
+      if (!isfinite(nr) || (it >= 3 && nr > 0.5 * prev)) break;
+      const double detyy = det_lead(2, J);
+      for (int i = 0; i < 3; ++i) dx[i] = -R[i];
+      const double det = gauss(3, J, dx);
+      if (!(det != 0.0) || !isfinite(det) || det * detyy <= 0.0) break;
+      info->newton_iters++;
+      for (int i = 0; i < 3; ++i) y[i] += dx[i];
+      prev = nr;
+    }
+    if (!ok) {
+      info->newton_iters = iters0;
+      return 2;
+    }
+    q->dc = q->dphi = q->dsf = q->dcf = q->dss = q->deta = q->dxi = q->detab = q->dst = 0.0;
+  }
+  *res = max_nn(fabs(R[0]), fabs(R[1]));
   return admissible(S, y, s, q) ? 0 : 1;
 }
 
@@ -777,6 +853,22 @@ static const mc_region dp_regions[] = {
     {2, {S_T1, S_T2, 0}, MPMC_MC_TENSION_EDGE},
     {3, {S_DP, S_T1, S_T2}, MPMC_MC_TENSION_CORNER},
 };
+
+/* Whether the regions with the cut-off can hold.  Without a user cut-off the cap at the apex
+ * is the cut-off, and on Mohr-Coulomb's surface s1 = c cot(phi) holds at the apex alone
+ * (there f = (1 - sin phi)(c cot(phi) - s3)); on Drucker-Prager's cone likewise whenever
+ * 2 eta_f / sqrt3 < 1 (s1 - p <= 2 sqrt(J2 / 3), so sqrt(J2) <= eta_f (s1 - p) only at
+ * J2 = 0), eta_f at the larger friction angle.  Then no region with the cut-off holds but at
+ * the apex, which principal's hydrostatic point gives: they are not tried (an apex return
+ * tried all eleven of Mohr-Coulomb's regions). */
+static int tension_regions(const mpmc_mc_param *m, const mc_mat *q0) {
+  if (isfinite(m->sigma_t)) return 1;
+  if (!isfinite(q0->st) || m->surface == MPMC_MC_MOHR_COULOMB) return 0;
+  const double phm = max_nn(m->phi_p, m->phi_r);
+  double eta, xi, deta, dxi;
+  dp_coef(m->surface, sin(phm), cos(phm), &eta, &xi, &deta, &dxi);
+  return !(2.0 * eta < 1.7320508075688772 * (1.0 - 1e-6));
+}
 
 /* the material is one mpmc_mc_return_principal accepts */
 static int param_ok(const mpmc_mc_param *m) {
@@ -867,7 +959,7 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
   if (!(isfinite(S.str[0]) && isfinite(S.str[2]))) return MPMC_ERR_NUMERIC;
   S.tolf = mpmc_mc_tolerance(m, S.str);
   S.yscale = max_nn(fabs(S.str[0]), fabs(S.str[2])) / m->G + 1e-300;
-  S.e0 = e_of(m, S.ep0);
+  S.e0 = q0in ? q0in->e : e_of(m, S.ep0);
   if (q0in)
     S.q0 = *q0in;
   else
@@ -888,7 +980,6 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
   const mc_region *regs = S.dp ? dp_regions : mc_regions;
   const int nreg = S.dp ? (int)(sizeof dp_regions / sizeof dp_regions[0])
                         : (int)(sizeof mc_regions / sizeof mc_regions[0]);
-  const int tension = isfinite(q0.st) || isfinite(m->sigma_t);
   int found = 0, r0 = 0;
   if (perfect || solver == MPMC_SOLVER_AUTO) { /* the first region in closed form */
     double y[MC_NMAX] = {0, 0, 0, 0}, R0;
@@ -907,10 +998,33 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
       r0 = 1; /* converged but not admissible: the general loop from the next region */
     }
   }
-  for (int r = r0; r < nreg && !found; ++r) {
+  /* the regions in order, but Mohr-Coulomb's extension edge before the compression edge when
+   * the main plane's return breaks s2 >= s3 more than s1 >= s2 (an edge return tried both) */
+  int order[16];
+  for (int r = 0; r < nreg; ++r) order[r] = r;
+  if (r0 == 1 && !S.dp && s[2] - s[1] > s[1] - s[0]) order[1] = 2, order[2] = 1;
+  if (r0 == 1 && !S.dp) /* the edges, that order, by edge_solve while it decides */
+    for (; r0 < 3 && !found; ++r0) {
+      const mc_region *rg = &regs[order[r0]];
+      double y[MC_NMAX], res;
+      mc_mat q;
+      S.n = rg->n;
+      memcpy(S.act, rg->act, sizeof S.act);
+      const int es = edge_solve(&S, perfect, y, s, &q, &res, info);
+      if (es == 2) break; /* the general loop from this region */
+      if (es == 1) continue;
+      found = 1;
+      info->region = rg->region;
+      info->dgamma = y[0] + y[1];
+      info->residual = res;
+      ep_new = S.ep0 + y[2];
+      if (q.st_apex && s[0] - s[2] <= 8.0 * S.tolf) info->region = MPMC_MC_APEX;
+    }
+  for (int ro = r0; ro < nreg && !found; ++ro) {
+    const int r = order[ro];
     int uses_t = 0;
     for (int j = 0; j < regs[r].n; ++j) uses_t |= regs[r].act[j] >= S_T1 && regs[r].act[j] <= S_T3;
-    if (uses_t && !tension) continue;
+    if (uses_t && !tension_regions(m, &q0)) continue;
     S.n = regs[r].n;
     memcpy(S.act, regs[r].act, sizeof S.act);
     double y[MC_NMAX] = {0, 0, 0, 0}, R[MC_NMAX];
@@ -919,13 +1033,16 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
     if (err) return err;
     if (fail) continue;
     mc_mat q = S.q0; /* the material at the solution, and the stress and residuals there */
-    if (!perfect) mat_eval(m, e_of(m, S.ep0 + y[S.n]), 1, &q, &S.q0);
+    if (!perfect) mat_eval(m, sys_e(&S, y[S.n]), 1, &q, &S.q0);
     mc_sys Se = S;
     Se.frozen = 1;
-    Se.e_frozen = perfect ? S.e0 : e_of(m, S.ep0 + y[S.n]);
+    Se.e_frozen = perfect ? S.e0 : q.e;
     Se.qf = q;
     sys_eval(&Se, y, R, NULL, s);
-    if (!admissible(&S, y, s, &q)) continue;
+    if (!admissible(&S, y, s, &q)) {
+      if (ro == 0 && !S.dp && s[2] - s[1] > s[1] - s[0]) order[1] = 2, order[2] = 1;
+      continue;
+    }
     found = 1;
     info->region = regs[r].region;
     info->dgamma = 0.0;
@@ -945,7 +1062,7 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
     const double dv[3] = {S.str[0] - p, S.str[1] - p, S.str[2] - p};
     const double D = sqrt(2.0 / 3.0) * sqrt(dot3(dv, dv)) / (2.0 * m->G);
     mc_mat q = S.q0;
-    if (!perfect) mat_eval(m, e_of(m, S.ep0 + D), 1, &q, &S.q0);
+    if (!perfect) mat_eval(m, sys_e(&S, D), 1, &q, &S.q0);
     /* the volume must shrink back (the apex is reached by a volumetric plastic expansion) */
     if (!isfinite(q.st) || !(p >= q.st - S.tolf)) return MPMC_ERR_SOLVER;
     s[0] = s[1] = s[2] = q.st;
@@ -966,10 +1083,14 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
 }
 
 /* The eigen path from the trial state: b its b_e, or (lg) eps = 1/2 ln b_e already formed by
- * the series, whose eigen-decomposition gives the principal strains without three logs. */
+ * the series, whose eigen-decomposition gives the principal strains without three logs; then
+ * btr is the trial b_e itself, and the returned b_e's eigenvalues are its own, q_a.b q_a,
+ * times exp(2 (eps_a - eps_tr,a)) (a small correction: return_map.h's polynomial; libm's
+ * exp beyond it), J likewise sqrt(det b) exp(tr(eps - eps_tr)): four exps less. */
 static int return_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double *b,
-                      int lg, double *be, double *eps_p, double *tau, double *J_out,
+                      const double *btr, double *be, double *eps_p, double *tau, double *J_out,
                       mpmc_mc_info *info, const mc_mat *q0) {
+  const int lg = btr != NULL;
   double lam[3], Q[3][3], etr[3], e[3], t[3];
   if (lg) /* the update's plastic points: closed form (the Jacobi sweeps cost ~5x the return) */
     mpmc_sym3_eig_closed(b, lam, Q);
@@ -992,10 +1113,25 @@ static int return_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const 
   } else {
     MPMC_CALL(mpmc_mc_return_principal(ws, solver, m, etr, &ep, e, t, info));
   }
-  for (int a = 0; a < 3; ++a) lam[a] = exp(2.0 * e[a]);
+  for (int a = 0; a < 3; ++a) {
+    const double d = 2.0 * (etr[a] - e[a]);
+    if (!lg || !(fabs(d) <= MPMC_RM_EXP_SMALL)) {
+      lam[a] = exp(2.0 * e[a]);
+      continue;
+    }
+    const double x = Q[0][a], y = Q[1][a], z = Q[2][a]; /* q_a . btr q_a */
+    const double lt = x * (btr[0] * x + btr[5] * y + btr[4] * z) +
+                      y * (btr[5] * x + btr[1] * y + btr[3] * z) +
+                      z * (btr[4] * x + btr[3] * y + btr[2] * z);
+    lam[a] = lt * MPMC_RM_EXP_NEG_POLY(d);
+  }
   mpmc_sym3_compose(lam, Q, be);
   mpmc_sym3_compose(t, Q, tau);
-  if (J_out) *J_out = exp(e[0] + e[1] + e[2]);
+  if (J_out) {
+    const double d = (etr[0] + etr[1] + etr[2]) - (e[0] + e[1] + e[2]);
+    *J_out = lg && fabs(d) <= MPMC_RM_EXP_SMALL ? sqrt(mpmc_det_sym(btr)) * MPMC_RM_EXP_NEG_POLY(d)
+                                                : exp(e[0] + e[1] + e[2]);
+  }
   *eps_p = ep;
   return MPMC_SUCCESS;
 }
@@ -1016,7 +1152,7 @@ int mpmc_mc_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, d
   double b[6];
   for (int k = 0; k < 6; ++k) b[k] = be[k];
   if (F) mpmc_push_forward(F, b);
-  return return_eig(ws, solver, m, b, 0, be, eps_p, tau, J_out, info, NULL);
+  return return_eig(ws, solver, m, b, NULL, be, eps_p, tau, J_out, info, NULL);
 }
 
 /**
@@ -1035,6 +1171,8 @@ void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre) {
   pre->gmax = sqrt(1.0 + q.sf * q.sf / 3.0);
   pre->st = q.st;
   pre->q0 = q;
+  for (int i = 0; i < MPMC_MC_NREF; ++i)
+    mat_eval(m, (double)i / (MPMC_MC_NREF - 1), 1, &pre->ref[i], NULL);
 }
 
 /* The elastic check of the trial b without eigenvectors.  Hencky strain eps by the series,
@@ -1065,9 +1203,13 @@ static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, d
   const double j2 = 0.5 * mpmc_sym3_norm2(s), rj = sqrt(j2);
   double sf = pre->sf, k = pre->k, eta = pre->eta, gmax = pre->gmax, st = pre->st;
   *qout = pre->q0;
+  if (pre->perfect && eps_p != 0.0 && m->eta > 0.0) qout->e = e_of(m, eps_p);
   if (!(pre->perfect || eps_p == 0.0)) {
     mc_mat q;
-    mat_eval(m, e_of(m, eps_p), 1, &q, NULL);
+    /* the sines and cosines from those of the nearest of pre's materials (sin_cos_near) */
+    const double ee = e_of(m, eps_p);
+    const int kr = (int)(ee * (MPMC_MC_NREF - 1) + 0.5);
+    mat_eval(m, ee, 1, &q, &pre->ref[kr < 0 ? 0 : kr > MPMC_MC_NREF - 1 ? MPMC_MC_NREF - 1 : kr]);
     *qout = q;
     sf = q.sf;
     k = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
@@ -1080,6 +1222,9 @@ static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, d
   const double r3 = 1.7320508075688772;
   int ok_f = mc ? 2.0 * rj * gmax + 2.0 * p * sf - k < -margin : rj + eta * p - k < -margin;
   if (!mc && !ok_f) return 0; /* Drucker-Prager's f is exact: not elastic by the margin */
+  /* Mohr-Coulomb's deviatoric part is at least sqrt(J2) (sqrt3 - sin(phi)/sqrt3) (at
+   * s1 = s2): beyond the surface by the margin with that, the point is plastic */
+  if (mc && !ok_f && rj * (r3 - sf / r3) + 2.0 * p * sf - k > margin) return 0;
   int ok_t = p + 2.0 * rj / r3 < st - margin;
   if (!(ok_f && ok_t)) {
     /* the largest and smallest principal deviatoric stresses from the invariants */
@@ -1130,7 +1275,9 @@ static int dp_radial(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, const d
   double st = q0->st, ratio;
   if (!(pre->perfect || ep == *eps_p)) {
     mc_mat q;
-    mat_eval(m, e_of(m, ep), 1, &q, q0);
+    const double x = m->eta * (ep - *eps_p); /* e0 exp(-x) for a small x, as sys_e */
+    mat_eval(m, fabs(x) <= MPMC_RM_EXP_SMALL ? q0->e * MPMC_RM_EXP_NEG_POLY(x) : e_of(m, ep), 1,
+             &q, q0);
     st = q.st;
   }
   const int k = fabs(etr[2] - tr / 3.0) > fabs(etr[0] - tr / 3.0) ? 2 : 0; /* largest |dev| */
@@ -1145,11 +1292,15 @@ static int dp_radial(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, const d
   for (int k = 0; k < 6; ++k) c[k] = 2.0 * (ratio - 1.0) * e[k];
   if (mpmc_sym3_exp_series(c, E)) return 1;
   mpmc_sym3_mul(b, E, be);
-  const double fv = exp(2.0 * (trn - tr) / 3.0);
+  /* the volume's factors exp(2 dtr / 3) and J = sqrt(det b) exp(dtr): polynomials of the
+   * small plastic dtr = tr(eps_new - eps) (return_map.h), libm's exp beyond */
+  const double dtr = trn - tr;
+  const int small = fabs(dtr) <= MPMC_RM_EXP_SMALL;
+  const double fv = small ? MPMC_RM_EXP_NEG_POLY(-2.0 * dtr / 3.0) : exp(2.0 * dtr / 3.0);
   for (int k = 0; k < 6; ++k) be[k] *= fv;
   for (int k = 0; k < 6; ++k) tau[k] = 2.0 * m->G * ratio * e[k];
   for (int k = 0; k < 3; ++k) tau[k] += pn;
-  if (J_out) *J_out = exp(trn);
+  if (J_out) *J_out = small ? sqrt(mpmc_det_sym(b)) * MPMC_RM_EXP_NEG_POLY(-dtr) : exp(trn);
   *eps_p = ep;
   if (info) *info = loc;
   return 0;
@@ -1177,8 +1328,8 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
   if (lg && pre->m.surface != MPMC_MC_MOHR_COULOMB &&
       !dp_radial(ws, solver, pre, b, eps, &q0, be, eps_p, tau, J_out, info))
     return MPMC_SUCCESS;
-  return return_eig(ws, solver, &pre->m, lg ? eps : b, lg, be, eps_p, tau, J_out, info,
-                    lg ? &q0 : NULL);
+  return return_eig(ws, solver, &pre->m, lg ? eps : b, lg ? b : NULL, be, eps_p, tau, J_out,
+                    info, lg ? &q0 : NULL);
 }
 
 /**

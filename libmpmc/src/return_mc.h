@@ -106,6 +106,7 @@ int mpmc_mc_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, d
 /* The material at one eps_p, its derivatives in eps_p and what its surfaces need (private
  * to return_mc.c; here for mpmc_mc_pre). */
 typedef struct {
+  double e;                       /* exp(-eta eps_p), the point of the softening curve     */
   double phi, psi;                /* the angles (the reference of nearby evaluations)     */
   double c, sf, cf, ss, cs;       /* c, sin/cos phi, sin/cos psi                          */
   double dc, dphi, dsf, dcf, dss; /* d/d eps_p                                            */
@@ -114,6 +115,8 @@ typedef struct {
   double st, dst;                 /* cut-off, capped at the apex                          */
   int st_apex;                    /* 1 when the cap (the apex) is the cut-off              */
 } mpmc_mc_mat;
+
+#define MPMC_MC_NREF 5
 
 /* What the elastic check of a point needs, worked out once per material (sines, cosines,
  * the cut-off's cap) for the points that have not yielded (eps_p = 0, most of a slope) and
@@ -130,6 +133,8 @@ typedef struct {
                   phi) / (2 sqrt(J2)) over the Lode angle                                */
   double st;   /* the cut-off at the peak, capped at the apex (INFINITY: none)          */
   mpmc_mc_mat q0; /* the material at eps_p = 0 (every eps_p under perfect plasticity)    */
+  mpmc_mc_mat ref[MPMC_MC_NREF]; /* at e = exp(-eta eps_p) = i / (MPMC_MC_NREF - 1): the
+                                    nearest seeds a point's sines and cosines             */
 } mpmc_mc_pre;
 
 void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre);
