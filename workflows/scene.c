@@ -1,7 +1,7 @@
-/* Scene files: YAML (libyaml's event parser) -> a tree that keeps file:line:column for
- * every key and value, `--set key.path=value` overrides applied to that tree, and typed,
- * range-checked reading of the tree into wf_scene.  Every error names the position and the
- * key: "slope.yaml:12:5: key 'grid.cell_size': must be > 0 (got -1)". */
+/* The scene schema: typed, range-checked reading of a scene file's tree (yaml.c: the tree,
+ * with file:line:column for every key and value, and the `--set` overrides) into wf_scene.
+ * Every error names the position and the key: "slope.yaml:12:5: key 'grid.cell_size': must
+ * be > 0 (got -1)". */
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -9,236 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <yaml.h>
 
 #include "wf.h"
-
-/* ---- the tree --------------------------------------------------------------------- */
-void wf_node_free(wf_node *n) {
-  if (!n) return;
-  for (int i = 0; i < n->n; ++i) {
-    wf_node_free(n->items[i]);
-    if (n->keys) free(n->keys[i]);
-  }
-  free(n->items);
-  free(n->keys);
-  free(n->key_line);
-  free(n->key_col);
-  free(n->value);
-  free(n);
-}
-
-static wf_node *node_new(wf_kind kind, int line, int col, const char *origin) {
-  wf_node *n = calloc(1, sizeof *n);
-  if (!n) return NULL;
-  n->kind = kind;
-  n->line = line;
-  n->col = col;
-  n->origin = origin;
-  return n;
-}
-
-static int node_push(wf_node *parent, const char *key, int kline, int kcol, wf_node *child) {
-  if (parent->n == parent->cap) {
-    const int cap = parent->cap ? 2 * parent->cap : 8;
-    wf_node **it = realloc(parent->items, sizeof *it * (size_t)cap);
-    if (!it) return -1;
-    parent->items = it;
-    if (parent->kind == WF_MAP) {
-      char **k = realloc(parent->keys, sizeof *k * (size_t)cap);
-      if (!k) return -1;
-      parent->keys = k;
-      int *kl = realloc(parent->key_line, sizeof *kl * (size_t)cap);
-      if (!kl) return -1;
-      parent->key_line = kl;
-      int *kc = realloc(parent->key_col, sizeof *kc * (size_t)cap);
-      if (!kc) return -1;
-      parent->key_col = kc;
-    }
-    parent->cap = cap;
-  }
-  if (parent->kind == WF_MAP) {
-    parent->keys[parent->n] = strdup(key);
-    if (!parent->keys[parent->n]) return -1;
-    parent->key_line[parent->n] = kline;
-    parent->key_col[parent->n] = kcol;
-  }
-  parent->items[parent->n++] = child;
-  return 0;
-}
-
-static int map_index(const wf_node *m, const char *key) {
-  if (!m || m->kind != WF_MAP) return -1;
-  for (int i = 0; i < m->n; ++i)
-    if (strcmp(m->keys[i], key) == 0) return i;
-  return -1;
-}
-
-static const wf_node *map_get(const wf_node *m, const char *key) {
-  const int i = map_index(m, key);
-  return i < 0 ? NULL : m->items[i];
-}
-
-/* ---- parsing: events -> tree --------------------------------------------------------- */
-#define WF_DEPTH 64
-typedef struct {
-  wf_node *node;
-  char *pending_key; /* map: the key waiting for its value */
-  int kline, kcol;
-  char path[512];
-} frame;
-
-static void frame_path(const frame *st, int depth, char *out, size_t len) {
-  /* the key path of the innermost value being parsed, for syntax errors */
-  out[0] = '\0';
-  for (int i = 0; i < depth; ++i) {
-    const wf_node *n = st[i].node;
-    char seg[128] = "";
-    if (n->kind == WF_MAP && st[i].pending_key)
-      snprintf(seg, sizeof seg, "%s", st[i].pending_key);
-    else if (n->kind == WF_MAP && n->n > 0)
-      snprintf(seg, sizeof seg, "%s", n->keys[n->n - 1]);
-    else if (n->kind == WF_SEQ)
-      snprintf(seg, sizeof seg, "%d", n->n);
-    if (!seg[0]) continue;
-    const size_t l = strlen(out);
-    snprintf(out + l, len - l, "%s%s", l ? "." : "", seg);
-  }
-}
-
-/* Parse YAML text into a tree.  origin names the source in messages. */
-static wf_node *parse_yaml(const unsigned char *text, size_t len, const char *origin, char *msg,
-                           size_t msglen) {
-  yaml_parser_t parser;
-  if (!yaml_parser_initialize(&parser)) {
-    snprintf(msg, msglen, "%s: cannot initialise the YAML parser", origin);
-    return NULL;
-  }
-  yaml_parser_set_input_string(&parser, text, len);
-  frame st[WF_DEPTH];
-  int depth = 0, done = 0, ndoc = 0;
-  wf_node *root = NULL;
-  while (!done) {
-    yaml_event_t ev;
-    if (!yaml_parser_parse(&parser, &ev)) {
-      char where[512];
-      frame_path(st, depth, where, sizeof where);
-      const yaml_mark_t mk = parser.problem_mark;
-      snprintf(msg, msglen, "%s:%zu:%zu: %skey '%s': YAML syntax error: %s%s%s", origin,
-               mk.line + 1, mk.column + 1, "", where[0] ? where : "(top level)",
-               parser.problem ? parser.problem : "unknown problem",
-               parser.context ? " " : "", parser.context ? parser.context : "");
-      goto fail;
-    }
-    const int line = (int)ev.start_mark.line + 1, col = (int)ev.start_mark.column + 1;
-    wf_node *made = NULL;
-    switch (ev.type) {
-      case YAML_STREAM_END_EVENT: done = 1; break;
-      case YAML_DOCUMENT_START_EVENT:
-        if (++ndoc > 1) {
-          snprintf(msg, msglen, "%s:%d:%d: key '(top level)': a scene is a single YAML document",
-                   origin, line, col);
-          yaml_event_delete(&ev);
-          goto fail;
-        }
-        break;
-      case YAML_ALIAS_EVENT: {
-        char where[512];
-        frame_path(st, depth, where, sizeof where);
-        snprintf(msg, msglen, "%s:%d:%d: key '%s': YAML aliases (*name) are not supported", origin,
-                 line, col, where);
-        yaml_event_delete(&ev);
-        goto fail;
-      }
-      case YAML_SCALAR_EVENT:
-        if (depth > 0 && st[depth - 1].node->kind == WF_MAP && !st[depth - 1].pending_key) {
-          frame *f = &st[depth - 1];
-          const char *k = (const char *)ev.data.scalar.value;
-          if (map_index(f->node, k) >= 0) {
-            char where[512];
-            frame_path(st, depth, where, sizeof where);
-            snprintf(msg, msglen, "%s:%d:%d: key '%s%s%s': duplicate key", origin, line, col, where,
-                     where[0] ? "." : "", k);
-            yaml_event_delete(&ev);
-            goto fail;
-          }
-          f->pending_key = strdup(k);
-          f->kline = line;
-          f->kcol = col;
-          break;
-        }
-        made = node_new(WF_SCALAR, line, col, origin);
-        if (made) {
-          made->value = strdup((const char *)ev.data.scalar.value);
-          made->quoted = ev.data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
-                         ev.data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE;
-        }
-        break;
-      case YAML_SEQUENCE_START_EVENT:
-        /* a list in a key's place ("[a, b]: c", found by fuzzing): keys are plain scalars */
-        if (depth > 0 && st[depth - 1].node->kind == WF_MAP && !st[depth - 1].pending_key) {
-          snprintf(msg, msglen, "%s:%d:%d: key '(complex)': only plain scalar keys are supported",
-                   origin, line, col);
-          yaml_event_delete(&ev);
-          goto fail;
-        }
-        made = node_new(WF_SEQ, line, col, origin);
-        break;
-      case YAML_MAPPING_START_EVENT:
-        if (depth > 0 && st[depth - 1].node->kind == WF_MAP && !st[depth - 1].pending_key) {
-          snprintf(msg, msglen, "%s:%d:%d: key '(complex)': only plain scalar keys are supported",
-                   origin, line, col);
-          yaml_event_delete(&ev);
-          goto fail;
-        }
-        made = node_new(WF_MAP, line, col, origin);
-        break;
-      case YAML_SEQUENCE_END_EVENT:
-      case YAML_MAPPING_END_EVENT: depth--; break;
-      default: break;
-    }
-    const int opens = ev.type == YAML_SEQUENCE_START_EVENT || ev.type == YAML_MAPPING_START_EVENT;
-    const int is_value = opens || (ev.type == YAML_SCALAR_EVENT && made);
-    yaml_event_delete(&ev);
-    if (is_value) {
-      if (!made) {
-        snprintf(msg, msglen, "%s: out of memory", origin);
-        goto fail;
-      }
-      if (depth == 0) {
-        root = made;
-      } else {
-        frame *f = &st[depth - 1];
-        int err = node_push(f->node, f->pending_key, f->kline, f->kcol, made);
-        free(f->pending_key);
-        f->pending_key = NULL;
-        if (err) {
-          wf_node_free(made);
-          snprintf(msg, msglen, "%s: out of memory", origin);
-          goto fail;
-        }
-      }
-      if (opens) {
-        if (depth == WF_DEPTH) {
-          snprintf(msg, msglen, "%s:%d:%d: key '(deep)': nesting deeper than %d levels", origin,
-                   line, col, WF_DEPTH);
-          goto fail;
-        }
-        st[depth].node = made;
-        st[depth].pending_key = NULL;
-        depth++;
-      }
-    }
-  }
-  yaml_parser_delete(&parser);
-  if (!root) root = node_new(WF_MAP, 1, 1, origin); /* empty document */
-  return root;
-fail:
-  for (int i = 0; i < depth; ++i) free(st[i].pending_key);
-  yaml_parser_delete(&parser);
-  wf_node_free(root);
-  return NULL;
-}
 
 /* ---- reading with checks ----------------------------------------------------------- */
 typedef struct {
@@ -269,10 +41,6 @@ static int fail_at(rd *r, const wf_node *n, const char *path, const char *fmt, .
   snprintf(r->msg, r->len, "%s: key '%s': %s", where, path, body);
   r->failed = 1;
   return -1;
-}
-
-static void join(char *out, size_t len, const char *path, const char *key) {
-  snprintf(out, len, "%s%s%s", path, path[0] ? "." : "", key);
 }
 
 static int edit_distance(const char *a, const char *b) {
@@ -310,7 +78,7 @@ static int check_map(rd *r, const wf_node *n, const char *path, const char *cons
     }
     if (!ok) {
       char full[512], where[WF_PATH + 32];
-      join(full, sizeof full, path, n->keys[i]);
+      wf_key_join(full, sizeof full, path, n->keys[i]);
       if (r->failed) return -1;
       snprintf(where, sizeof where, "%s:%d:%d", n->origin, n->key_line[i], n->key_col[i]);
       if (n->line == 0 || n->key_line[i] == 0) snprintf(where, sizeof where, "--set");
@@ -376,8 +144,8 @@ static int check_range(rd *r, const wf_node *n, const char *path, double v, rang
 static int get_num(rd *r, const wf_node *map, const char *path, const char *key, int required,
                    double def, range g, double *out) {
   char full[512];
-  join(full, sizeof full, path, key);
-  const wf_node *n = map_get(map, key);
+  wf_key_join(full, sizeof full, path, key);
+  const wf_node *n = wf_map_get(map, key);
   if (!n) {
     if (required) return fail_at(r, map, full, "required key is missing");
     *out = def;
@@ -392,12 +160,12 @@ static int get_num(rd *r, const wf_node *map, const char *path, const char *key,
 
 static int get_int(rd *r, const wf_node *map, const char *path, const char *key, int required,
                    int def, int lo, int hi, int *out) {
-  double v;
+  double v = 0.0;
   char full[512];
-  join(full, sizeof full, path, key);
+  wf_key_join(full, sizeof full, path, key);
   const range g = {lo, hi, 0, 0};
   if (get_num(r, map, path, key, required, def, g, &v)) return -1;
-  if (v != floor(v)) return fail_at(r, map_get(map, key), full, "expected a whole number (got %g)", v);
+  if (v != floor(v)) return fail_at(r, wf_map_get(map, key), full, "expected a whole number (got %g)", v);
   *out = (int)v;
   return 0;
 }
@@ -417,8 +185,8 @@ static int bool_word(const wf_node *n) {
 
 static int get_bool(rd *r, const wf_node *map, const char *path, const char *key, int def, int *out) {
   char full[512];
-  join(full, sizeof full, path, key);
-  const wf_node *n = map_get(map, key);
+  wf_key_join(full, sizeof full, path, key);
+  const wf_node *n = wf_map_get(map, key);
   if (!n) return *out = def, 0;
   const int b = bool_word(n);
   if (b >= 0) return *out = b, 0;
@@ -428,8 +196,8 @@ static int get_bool(rd *r, const wf_node *map, const char *path, const char *key
 static int get_str(rd *r, const wf_node *map, const char *path, const char *key, int required,
                    const char *def, char *out, size_t len) {
   char full[512];
-  join(full, sizeof full, path, key);
-  const wf_node *n = map_get(map, key);
+  wf_key_join(full, sizeof full, path, key);
+  const wf_node *n = wf_map_get(map, key);
   if (!n) {
     if (required) return fail_at(r, map, full, "required key is missing");
     snprintf(out, len, "%s", def);
@@ -446,24 +214,24 @@ static int get_str(rd *r, const wf_node *map, const char *path, const char *key,
 static int get_enum(rd *r, const wf_node *map, const char *path, const char *key, int required,
                     int def, const char *const *words, int *out) {
   char full[512], buf[WF_NAME];
-  join(full, sizeof full, path, key);
+  wf_key_join(full, sizeof full, path, key);
   if (get_str(r, map, path, key, required, "", buf, sizeof buf)) return -1;
-  if (!map_get(map, key)) return *out = def, 0;
+  if (!wf_map_get(map, key)) return *out = def, 0;
   char list[256] = "";
   for (int i = 0; words[i]; ++i) {
     if (!strcmp(buf, words[i])) return *out = i, 0;
     const size_t l = strlen(list);
     snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", words[i]);
   }
-  return fail_at(r, map_get(map, key), full, "must be one of %s (got '%s')", list, buf);
+  return fail_at(r, wf_map_get(map, key), full, "must be one of %s (got '%s')", list, buf);
 }
 
 /* A list of exactly n numbers. */
 static int get_vec(rd *r, const wf_node *map, const char *path, const char *key, int required,
                    int n, range g, double *out) {
   char full[512];
-  join(full, sizeof full, path, key);
-  const wf_node *v = map_get(map, key);
+  wf_key_join(full, sizeof full, path, key);
+  const wf_node *v = wf_map_get(map, key);
   if (!v) {
     if (required) return fail_at(r, map, full, "required key is missing");
     return 0;
@@ -486,8 +254,8 @@ static int get_vec(rd *r, const wf_node *map, const char *path, const char *key,
 static int get_points(rd *r, const wf_node *map, const char *path, const char *key, int min, double **xy,
                       int *n) {
   char full[512];
-  join(full, sizeof full, path, key);
-  const wf_node *v = map_get(map, key);
+  wf_key_join(full, sizeof full, path, key);
+  const wf_node *v = wf_map_get(map, key);
   if (!v) return fail_at(r, map, full, "required key is missing");
   if (v->kind != WF_SEQ || v->n < min)
     return fail_at(r, v, full, "expected a list of at least %d [x, y] point%s", min, min == 1 ? "" : "s");
@@ -505,104 +273,6 @@ static int get_points(rd *r, const wf_node *map, const char *path, const char *k
       return fail_at(r, p, item, "expected finite coordinates (got [%g, %g])", q[0], q[1]);
   }
   return 0;
-}
-
-/* ---- --set overrides ------------------------------------------------------------------- */
-static int apply_override(wf_node *root, const char *arg, const char *origin, char *msg, size_t len) {
-  const char *eq = strchr(arg, '=');
-  if (!eq || eq == arg) {
-    snprintf(msg, len, "--set %s: key '%s': expected key.path=value", arg, arg);
-    return -1;
-  }
-  char path[512];
-  const size_t pl = (size_t)(eq - arg);
-  if (pl >= sizeof path) {
-    snprintf(msg, len, "--set %s: key path too long", arg);
-    return -1;
-  }
-  memcpy(path, arg, pl);
-  path[pl] = '\0';
-  const char *val = eq + 1;
-  wf_node *value = parse_yaml((const unsigned char *)val, strlen(val), origin, msg, len);
-  if (!value) return -1;
-  /* the value's nodes report the --set argument as their origin, without line numbers */
-  wf_node *stack[WF_DEPTH];
-  int sp = 0;
-  stack[sp++] = value;
-  while (sp) {
-    wf_node *n = stack[--sp];
-    n->line = 0;
-    for (int i = 0; i < n->n && sp < WF_DEPTH; ++i) stack[sp++] = n->items[i];
-  }
-  if (value->kind == WF_MAP && value->n == 0 && !val[0]) {
-    wf_node_free(value);
-    snprintf(msg, len, "--set %s: key '%s': empty value", arg, path);
-    return -1;
-  }
-  wf_node *cur = root;
-  char *save = NULL;
-  char *seg = strtok_r(path, ".", &save);
-  char done[512] = "";
-  while (seg) {
-    char *next = strtok_r(NULL, ".", &save);
-    char sofar[512];
-    join(sofar, sizeof sofar, done, seg);
-    if (cur->kind == WF_MAP) {
-      int i = map_index(cur, seg);
-      if (!next) {
-        if (i >= 0) {
-          wf_node_free(cur->items[i]);
-          cur->items[i] = value;
-        } else if (node_push(cur, seg, 0, 0, value)) {
-          wf_node_free(value);
-          snprintf(msg, len, "out of memory");
-          return -1;
-        }
-        return 0;
-      }
-      if (i < 0) {
-        wf_node *m = node_new(WF_MAP, 0, 0, origin);
-        if (!m || node_push(cur, seg, 0, 0, m)) {
-          wf_node_free(m);
-          wf_node_free(value);
-          snprintf(msg, len, "out of memory");
-          return -1;
-        }
-        i = cur->n - 1;
-      }
-      cur = cur->items[i];
-    } else if (cur->kind == WF_SEQ) {
-      int idx = -1;
-      char *end;
-      const long l = strtol(seg, &end, 10);
-      if (!*end && l >= 0 && l < cur->n) idx = (int)l;
-      for (int i = 0; idx < 0 && i < cur->n; ++i) {
-        const wf_node *nm = map_get(cur->items[i], "name");
-        if (nm && nm->kind == WF_SCALAR && !strcmp(nm->value, seg)) idx = i;
-      }
-      if (idx < 0) {
-        snprintf(msg, len, "--set %s: key '%s': no list item '%s' (give an index 0..%d or a name)",
-                 arg, sofar, seg, cur->n - 1);
-        wf_node_free(value);
-        return -1;
-      }
-      if (!next) {
-        wf_node_free(cur->items[idx]);
-        cur->items[idx] = value;
-        return 0;
-      }
-      cur = cur->items[idx];
-    } else {
-      snprintf(msg, len, "--set %s: key '%s': is a value, it has no key '%s'", arg, done, seg);
-      wf_node_free(value);
-      return -1;
-    }
-    snprintf(done, sizeof done, "%s", sofar);
-    seg = next;
-  }
-  wf_node_free(value);
-  snprintf(msg, len, "--set %s: key '': empty key path", arg);
-  return -1;
 }
 
 /* ---- the scene schema ------------------------------------------------------------------ */
@@ -657,10 +327,10 @@ static int read_material(rd *r, const wf_node *mn, const char *path, wf_material
   /* aliases first: su gives kappa_p = sqrt(3) su, unless kappa_p is given too */
   for (int k = mi.nstore; k < mi.nparam; ++k) {
     const mpmc_param_info *a = &pi[k];
-    const wf_node *an = map_get(mn, a->name);
+    const wf_node *an = wf_map_get(mn, a->name);
     if (!an) continue;
-    join(full, sizeof full, path, a->name);
-    if (map_get(mn, pi[a->alias_of].name))
+    wf_key_join(full, sizeof full, path, a->name);
+    if (wf_map_get(mn, pi[a->alias_of].name))
       return fail_at(r, an, full, "give %s or %s, not both", pi[a->alias_of].name, a->name);
     const range g = {a->lo, a->hi, a->lo_open, a->hi_open};
     double v;
@@ -670,8 +340,8 @@ static int read_material(rd *r, const wf_node *mn, const char *path, wf_material
   for (int k = 0; k < mi.nstore; ++k) {
     const mpmc_param_info *q = &pi[k];
     if (!isnan(m->par[k])) continue; /* given by its alias */
-    const wf_node *qn = map_get(mn, q->name);
-    join(full, sizeof full, path, q->name);
+    const wf_node *qn = wf_map_get(mn, q->name);
+    wf_key_join(full, sizeof full, path, q->name);
     if (!qn && !q->optional) {
       char alias[64] = "";
       for (int a = mi.nstore; a < mi.nparam; ++a)
@@ -697,9 +367,9 @@ static int read_material(rd *r, const wf_node *mn, const char *path, wf_material
     if (t < 0 || !(m->par[k] > m->par[t])) continue;
     const char *key = pi[k].name;
     for (int a = mi.nstore; a < mi.nparam; ++a)
-      if (pi[a].alias_of == k && map_get(mn, pi[a].name)) key = pi[a].name;
-    const wf_node *kn = map_get(mn, key);
-    join(full, sizeof full, path, key);
+      if (pi[a].alias_of == k && wf_map_get(mn, pi[a].name)) key = pi[a].name;
+    const wf_node *kn = wf_map_get(mn, key);
+    wf_key_join(full, sizeof full, path, key);
     return fail_at(r, kn ? kn : mn, full, "must not exceed %s = %g (got %g)", pi[t].name,
                    m->par[t], m->par[k]);
   }
@@ -707,7 +377,7 @@ static int read_material(rd *r, const wf_node *mn, const char *path, wf_material
 }
 
 static int read_materials(rd *r, const wf_node *root, wf_scene *sc) {
-  const wf_node *ms = map_get(root, "materials");
+  const wf_node *ms = wf_map_get(root, "materials");
   if (!ms) return fail_at(r, root, "materials", "required key is missing");
   if (ms->kind != WF_MAP || ms->n == 0)
     return fail_at(r, ms, "materials", "expected a map of named materials, e.g. clay: {model: hencky_j2, ...}");
@@ -726,7 +396,7 @@ static int read_materials(rd *r, const wf_node *root, wf_scene *sc) {
 
 static int find_material(rd *r, const wf_scene *sc, const wf_node *map, const char *path, int *out) {
   char name[WF_NAME], full[512];
-  join(full, sizeof full, path, "material");
+  wf_key_join(full, sizeof full, path, "material");
   if (get_str(r, map, path, "material", sc->nmat != 1, sc->mats[0].name, name, sizeof name)) return -1;
   for (int i = 0; i < sc->nmat; ++i)
     if (!strcmp(sc->mats[i].name, name)) return *out = i, 0;
@@ -735,7 +405,7 @@ static int find_material(rd *r, const wf_scene *sc, const wf_node *map, const ch
     const size_t l = strlen(list);
     snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", sc->mats[i].name);
   }
-  return fail_at(r, map_get(map, "material"), full, "no material '%s' (materials: %s)", name, list);
+  return fail_at(r, wf_map_get(map, "material"), full, "no material '%s' (materials: %s)", name, list);
 }
 
 static int file_exists(const char *p) {
@@ -744,7 +414,7 @@ static int file_exists(const char *p) {
 }
 
 static int read_geometry(rd *r, const wf_node *root, wf_scene *sc) {
-  const wf_node *gs = map_get(root, "geometry");
+  const wf_node *gs = wf_map_get(root, "geometry");
   if (!gs) return fail_at(r, root, "geometry", "required key is missing");
   if (gs->kind != WF_SEQ || gs->n == 0)
     return fail_at(r, gs, "geometry", "expected a list of bodies, e.g. - {type: box, lo: [..], hi: [..]}");
@@ -770,24 +440,24 @@ static int read_geometry(rd *r, const wf_node *root, wf_scene *sc) {
         return -1;
       for (int a = 0; a < sc->dim; ++a)
         if (b->hi[a] <= b->lo[a]) {
-          join(full, sizeof full, path, "hi");
-          return fail_at(r, map_get(g, "hi"), full, "component %d must be > lo (%g) (got %g)", a,
+          wf_key_join(full, sizeof full, path, "hi");
+          return fail_at(r, wf_map_get(g, "hi"), full, "component %d must be > lo (%g) (got %g)", a,
                          b->lo[a], b->hi[a]);
         }
     } else if (b->type == WF_GEOM_POLYGON) {
-      join(full, sizeof full, path, "vertices");
-      if (sc->dim != 2) return fail_at(r, map_get(g, "type"), full, "polygons are 2D only (dim = %d)", sc->dim);
+      wf_key_join(full, sizeof full, path, "vertices");
+      if (sc->dim != 2) return fail_at(r, wf_map_get(g, "type"), full, "polygons are 2D only (dim = %d)", sc->dim);
       if (get_points(r, g, path, "vertices", 3, &b->xy, &b->nvert)) return -1;
     } else {
       char file[WF_PATH];
-      join(full, sizeof full, path, "file");
+      wf_key_join(full, sizeof full, path, "file");
       if (get_str(r, g, path, "file", 1, "", file, sizeof file)) return -1;
       if (file[0] == '/')
         snprintf(b->file, sizeof b->file, "%s", file);
       else if (snprintf(b->file, sizeof b->file, "%s/%s", sc->dir, file) >= (int)sizeof b->file)
-        return fail_at(r, map_get(g, "file"), full, "path too long");
+        return fail_at(r, wf_map_get(g, "file"), full, "path too long");
       if (!file_exists(b->file))
-        return fail_at(r, map_get(g, "file"), full, "mesh file '%s' not found (paths are relative to the scene file)",
+        return fail_at(r, wf_map_get(g, "file"), full, "mesh file '%s' not found (paths are relative to the scene file)",
                        b->file);
       if (get_enum(r, g, path, "seeding", 0, MPMC_SEED_LATTICE, modes, &b->mode)) return -1;
       if (get_str(r, g, path, "region", 1, "", b->region, sizeof b->region)) return -1;
@@ -812,25 +482,25 @@ static int read_walls(rd *r, const wf_node *list, const char *path, const wf_sce
     if (get_str(r, n, p, "name", 0, "", w->name, sizeof w->name)) return -1;
     if (get_enum(r, n, p, "kind", 1, 0, wall_kind_words, &w->kind)) return -1;
     int side = 0;
-    if (map_get(n, "face")) {
+    if (wf_map_get(n, "face")) {
       w->form = 0;
       if (get_enum(r, n, p, "face", 1, 0, face_words, &w->face)) return -1;
-      join(full, sizeof full, p, "face");
-      if (w->face >= 2 * sc->dim) return fail_at(r, map_get(n, "face"), full, "no such face in %dD", sc->dim);
-    } else if (map_get(n, "position")) {
+      wf_key_join(full, sizeof full, p, "face");
+      if (w->face >= 2 * sc->dim) return fail_at(r, wf_map_get(n, "face"), full, "no such face in %dD", sc->dim);
+    } else if (wf_map_get(n, "position")) {
       w->form = 1;
       if (get_enum(r, n, p, "axis", 1, 0, axis_words, &w->axis)) return -1;
       if (get_num(r, n, p, "position", 1, 0, ANY, &w->position)) return -1;
       if (get_enum(r, n, p, "side", 1, 0, sides, &side)) return -1;
       w->side = side ? 1 : -1;
-    } else if (map_get(n, "lo") || map_get(n, "hi")) {
+    } else if (wf_map_get(n, "lo") || wf_map_get(n, "hi")) {
       w->form = 2;
       if (get_vec(r, n, p, "lo", 1, sc->dim, ANY, w->lo) || get_vec(r, n, p, "hi", 1, sc->dim, ANY, w->hi))
         return -1;
       if (get_enum(r, n, p, "axis", w->kind != MPMC_WALL_FIXED, 0, axis_words, &w->axis)) return -1;
       if (get_enum(r, n, p, "side", w->kind == MPMC_WALL_SEPARABLE, 0, sides, &side)) return -1;
       w->side = side ? 1 : -1;
-    } else if (map_get(n, "set")) {
+    } else if (wf_map_get(n, "set")) {
       /* the nodes of a gmsh boundary group (node set); checked against the mesh at run time */
       w->form = 3;
       if (get_str(r, n, p, "set", 1, "", w->set, sizeof w->set)) return -1;
@@ -840,8 +510,8 @@ static int read_walls(rd *r, const wf_node *list, const char *path, const wf_sce
     } else {
       return fail_at(r, n, p, "a wall needs face, or axis+position+side, or a box lo+hi, or a node set");
     }
-    join(full, sizeof full, p, "axis");
-    if (w->axis >= sc->dim) return fail_at(r, map_get(n, "axis"), full, "no axis z in 2D");
+    wf_key_join(full, sizeof full, p, "axis");
+    if (w->axis >= sc->dim) return fail_at(r, wf_map_get(n, "axis"), full, "no axis z in 2D");
   }
   return 0;
 }
@@ -849,7 +519,7 @@ static int read_walls(rd *r, const wf_node *list, const char *path, const wf_sce
 /* rigid_bodies: a list of {name, type: box|polygon, lo/hi | vertices, friction}; contact:
  * {dhat, kappa} (rigid.c, docs/contact.md).  Read before the stages, which move them. */
 static int read_rigid(rd *r, const wf_node *root, wf_scene *sc) {
-  const wf_node *cn = map_get(root, "contact");
+  const wf_node *cn = wf_map_get(root, "contact");
   if (cn) {
     static const char *const ck[] = {"dhat", "kappa", NULL};
     if (check_map(r, cn, "contact", ck)) return -1;
@@ -857,7 +527,7 @@ static int read_rigid(rd *r, const wf_node *root, wf_scene *sc) {
         get_num(r, cn, "contact", "kappa", 0, 0, NONNEG, &sc->contact_kappa))
       return -1;
   }
-  const wf_node *rs = map_get(root, "rigid_bodies");
+  const wf_node *rs = wf_map_get(root, "rigid_bodies");
   if (!rs) return 0;
   if (rs->kind != WF_SEQ || rs->n == 0)
     return fail_at(r, rs, "rigid_bodies", "expected a list of bodies, e.g. - {name: footing, type: box, lo: [..], hi: [..]}");
@@ -877,8 +547,8 @@ static int read_rigid(rd *r, const wf_node *root, wf_scene *sc) {
     if (get_str(r, g, path, "name", 0, def, b->name, sizeof b->name)) return -1;
     for (int j = 0; j < i; ++j)
       if (!strcmp(sc->rigid[j].name, b->name)) {
-        join(full, sizeof full, path, "name");
-        return fail_at(r, map_get(g, "name"), full, "a rigid body named '%s' exists already", b->name);
+        wf_key_join(full, sizeof full, path, "name");
+        return fail_at(r, wf_map_get(g, "name"), full, "a rigid body named '%s' exists already", b->name);
       }
     if (get_enum(r, g, path, "type", 1, 0, types, &b->type)) return -1;
     if (get_num(r, g, path, "friction", 0, 0, NONNEG, &b->friction)) return -1;
@@ -887,14 +557,14 @@ static int read_rigid(rd *r, const wf_node *root, wf_scene *sc) {
         return -1;
       for (int a = 0; a < sc->dim; ++a)
         if (b->hi[a] <= b->lo[a]) {
-          join(full, sizeof full, path, "hi");
-          return fail_at(r, map_get(g, "hi"), full, "component %d must be > lo (%g) (got %g)", a, b->lo[a],
+          wf_key_join(full, sizeof full, path, "hi");
+          return fail_at(r, wf_map_get(g, "hi"), full, "component %d must be > lo (%g) (got %g)", a, b->lo[a],
                          b->hi[a]);
         }
       continue;
     }
-    join(full, sizeof full, path, "vertices");
-    if (sc->dim != 2) return fail_at(r, map_get(g, "type"), full, "rigid polygons are 2D only (dim = %d)", sc->dim);
+    wf_key_join(full, sizeof full, path, "vertices");
+    if (sc->dim != 2) return fail_at(r, wf_map_get(g, "type"), full, "rigid polygons are 2D only (dim = %d)", sc->dim);
     if (get_points(r, g, path, "vertices", 3, &b->xy, &b->nvert)) return -1;
   }
   return 0;
@@ -903,7 +573,7 @@ static int read_rigid(rd *r, const wf_node *root, wf_scene *sc) {
 /* stages.N.rigid_bodies: {NAME: {velocity: [..], ramp: T}} */
 static int read_motion(rd *r, const wf_node *n, const char *path, const wf_scene *sc, wf_stage *s) {
   char full[512];
-  join(full, sizeof full, path, "rigid_bodies");
+  wf_key_join(full, sizeof full, path, "rigid_bodies");
   if (n->kind != WF_MAP || n->n == 0)
     return fail_at(r, n, full, "expected a map of body names, e.g. footing: {velocity: [0, -0.01], ramp: 0.2}");
   s->motion = calloc((size_t)n->n, sizeof *s->motion);
@@ -943,9 +613,9 @@ static int read_bearing(rd *r, const wf_node *v, const char *p, wf_scene *sc) {
   m->bearing_body = -1;
   for (int b = 0; b < sc->nrigid; ++b)
     if (!strcmp(sc->rigid[b].name, name)) m->bearing_body = b;
-  join(full, sizeof full, p, "body");
+  wf_key_join(full, sizeof full, p, "body");
   if (m->bearing_body < 0)
-    return fail_at(r, map_get(v, "body") ? map_get(v, "body") : v, full, "no rigid body '%s'", name);
+    return fail_at(r, wf_map_get(v, "body") ? wf_map_get(v, "body") : v, full, "no rigid body '%s'", name);
   const range from = {0, 1, 0, 1};
   if (get_num(r, v, p, "width", 1, 0, POS, &m->bearing_B) ||
       get_num(r, v, p, "loaded_width", 0, m->bearing_B, POS, &m->bearing_width) ||
@@ -953,14 +623,14 @@ static int read_bearing(rd *r, const wf_node *v, const char *p, wf_scene *sc) {
       get_enum(r, v, p, "axis", 0, sc->dim - 1, axis_words, &m->bearing_axis) ||
       get_num(r, v, p, "from", 0, 0.5, from, &m->bearing_from))
     return -1;
-  join(full, sizeof full, p, "axis");
-  if (m->bearing_axis >= sc->dim) return fail_at(r, map_get(v, "axis"), full, "no axis z in 2D");
+  wf_key_join(full, sizeof full, p, "axis");
+  if (m->bearing_axis >= sc->dim) return fail_at(r, wf_map_get(v, "axis"), full, "no axis z in 2D");
   m->enabled[WF_METRIC_SETTLEMENT_B] = m->enabled[WF_METRIC_Q_SU] = m->enabled[WF_METRIC_BEARING] = 1;
   return 0;
 }
 
 static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
-  const wf_node *ss = map_get(root, "stages");
+  const wf_node *ss = wf_map_get(root, "stages");
   if (!ss) return fail_at(r, root, "stages", "required key is missing");
   if (ss->kind != WF_SEQ || ss->n == 0) return fail_at(r, ss, "stages", "expected a list of stages");
   sc->nstage = ss->n;
@@ -982,7 +652,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     snprintf(def, sizeof def, "stage%d", i + 1);
     if (check_map(r, n, p, keys)) return -1;
     if (get_str(r, n, p, "name", 0, def, s->name, sizeof s->name)) return -1;
-    if (map_get(n, "gravity")) {
+    if (wf_map_get(n, "gravity")) {
       s->has_gravity = 1;
       if (get_vec(r, n, p, "gravity", 1, sc->dim, ANY, s->gravity)) return -1;
     }
@@ -991,12 +661,12 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     if (get_bool(r, n, p, "kinetic_damping", 0, &s->kinetic_damping)) return -1;
     /* the damping ratio zeta of the estimated mode; true: 0.7 (the Rayleigh quotient bounds the
      * lowest mode from above; docs/workflows.md), false: off */
-    const wf_node *ad = map_get(n, "adaptive_damping");
+    const wf_node *ad = wf_map_get(n, "adaptive_damping");
     const int adb = ad ? bool_word(ad) : -1;
     if (adb >= 0) {
       s->adaptive_damping = adb ? 0.7 : 0.0;
     } else if (ad) {
-      join(full, sizeof full, p, "adaptive_damping");
+      wf_key_join(full, sizeof full, p, "adaptive_damping");
       if (parse_number(ad, &s->adaptive_damping))
         return fail_at(r, ad, full, "expected true, false or a damping ratio in [0, 2] (got '%s')",
                        shown(ad));
@@ -1015,21 +685,21 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     const range fac = {0, 1, 1, 0};
     if (get_num(r, n, p, "dt_factor", 0, 0.3, fac, &s->dt_factor)) return -1;
     if (get_num(r, n, p, "dt", 0, 0, NONNEG, &s->dt)) return -1;
-    const wf_node *is = map_get(n, "initial_stress");
+    const wf_node *is = wf_map_get(n, "initial_stress");
     if (is) {
       static const char *const ik[] = {"k0", NULL};
-      join(full, sizeof full, p, "initial_stress");
+      wf_key_join(full, sizeof full, p, "initial_stress");
       if (check_map(r, is, full, ik) || get_num(r, is, full, "k0", 1, 0, POS, &s->k0)) return -1;
     }
     if (get_int(r, n, p, "snapshots", 0, 4, 0, 100000, &s->snapshots)) return -1;
     if (get_int(r, n, p, "series_points", 0, 200, 1, 10000000, &s->series_points)) return -1;
     char wp[128];
     snprintf(wp, sizeof wp, "%s.walls", p);
-    if (map_get(n, "walls") && read_walls(r, map_get(n, "walls"), wp, sc, s)) return -1;
-    if (map_get(n, "rigid_bodies") && read_motion(r, map_get(n, "rigid_bodies"), p, sc, s)) return -1;
-    const wf_node *rm = map_get(n, "remove_walls");
+    if (wf_map_get(n, "walls") && read_walls(r, wf_map_get(n, "walls"), wp, sc, s)) return -1;
+    if (wf_map_get(n, "rigid_bodies") && read_motion(r, wf_map_get(n, "rigid_bodies"), p, sc, s)) return -1;
+    const wf_node *rm = wf_map_get(n, "remove_walls");
     if (rm) {
-      join(full, sizeof full, p, "remove_walls");
+      wf_key_join(full, sizeof full, p, "remove_walls");
       if (rm->kind != WF_SEQ) return fail_at(r, rm, full, "expected a list of wall names");
       s->nremove = rm->n;
       s->remove = calloc((size_t)rm->n + 1, sizeof *s->remove);
@@ -1046,9 +716,9 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
           return fail_at(r, rm->items[k], full, "no wall named '%s' in an earlier stage", s->remove[k]);
       }
     }
-    const wf_node *tr = map_get(n, "tractions");
+    const wf_node *tr = wf_map_get(n, "tractions");
     if (tr) {
-      join(full, sizeof full, p, "tractions");
+      wf_key_join(full, sizeof full, p, "tractions");
       if (tr->kind != WF_SEQ) return fail_at(r, tr, full, "expected a list of tractions");
       s->ntractions = tr->n;
       s->tractions = calloc((size_t)tr->n + 1, sizeof *s->tractions);
@@ -1059,7 +729,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
         wf_traction *t = &s->tractions[k];
         if (check_map(r, tr->items[k], tp, tr_keys)) return -1;
         if (get_str(r, tr->items[k], tp, "set", 0, "", t->set, sizeof t->set)) return -1;
-        t->has_region = map_get(tr->items[k], "lo") != NULL;
+        t->has_region = wf_map_get(tr->items[k], "lo") != NULL;
         if (t->has_region && (get_vec(r, tr->items[k], tp, "lo", 1, sc->dim, ANY, t->lo) ||
                               get_vec(r, tr->items[k], tp, "hi", 1, sc->dim, ANY, t->hi)))
           return -1;
@@ -1068,10 +738,10 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
         if (get_vec(r, tr->items[k], tp, "traction", 1, sc->dim, ANY, t->traction)) return -1;
       }
     }
-    const wf_node *fn = map_get(n, "factor_of_safety");
+    const wf_node *fn = wf_map_get(n, "factor_of_safety");
     if (fn) {
       /* a search: trials from this stage's start, each as long as its end (docs/workflows.md) */
-      join(full, sizeof full, p, "factor_of_safety");
+      wf_key_join(full, sizeof full, p, "factor_of_safety");
       if (check_map(r, fn, full, fos_keys)) return -1;
       wf_fos *f = &s->fos;
       s->has_fos = 1;
@@ -1083,17 +753,17 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
           get_int(r, fn, full, "jobs", 0, 1, 1, WF_FOS_MAX_JOBS, &f->jobs))
         return -1;
       char hp[600];
-      join(hp, sizeof hp, full, "hi");
+      wf_key_join(hp, sizeof hp, full, "hi");
       if (!(f->hi > f->lo)) return fail_at(r, fn, hp, "must be above lo = %g (got %g)", f->lo, f->hi);
-      if (map_get(n, "strength_reduction"))
-        return fail_at(r, map_get(n, "strength_reduction"), full,
+      if (wf_map_get(n, "strength_reduction"))
+        return fail_at(r, wf_map_get(n, "strength_reduction"), full,
                        "a factor-of-safety stage sets its own factors: remove strength_reduction");
     }
-    const wf_node *e = map_get(n, "end");
-    join(full, sizeof full, p, "end");
+    const wf_node *e = wf_map_get(n, "end");
+    wf_key_join(full, sizeof full, p, "end");
     if (!e) return fail_at(r, n, full, "required key is missing (time: T, or kinetic_energy_ratio: tol with max_time: T)");
     if (check_map(r, e, full, end_keys)) return -1;
-    const int has_t = map_get(e, "time") != NULL, has_k = map_get(e, "kinetic_energy_ratio") != NULL;
+    const int has_t = wf_map_get(e, "time") != NULL, has_k = wf_map_get(e, "kinetic_energy_ratio") != NULL;
     if (has_t == has_k)
       return fail_at(r, e, full, "give exactly one of time (a duration) or kinetic_energy_ratio (quasi-static)");
     if (has_t) {
@@ -1106,9 +776,9 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
       if (get_num(r, e, full, "max_time", 1, 0, POS, &s->max_time)) return -1;
       if (get_num(r, e, full, "min_time", 0, 0, NONNEG, &s->min_time)) return -1;
       char mt[560];
-      join(mt, sizeof mt, full, "min_time");
+      wf_key_join(mt, sizeof mt, full, "min_time");
       if (s->min_time > s->max_time)
-        return fail_at(r, map_get(e, "min_time"), mt, "must not exceed max_time = %g (got %g)", s->max_time,
+        return fail_at(r, wf_map_get(e, "min_time"), mt, "must not exceed max_time = %g (got %g)", s->max_time,
                        s->min_time);
       s->end_time = s->max_time;
     }
@@ -1120,7 +790,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
 static int find_stage(rd *r, const wf_node *map, const char *path, const char *key, const wf_scene *sc, int def,
                       int *out) {
   char name[WF_NAME], full[512];
-  join(full, sizeof full, path, key);
+  wf_key_join(full, sizeof full, path, key);
   if (get_str(r, map, path, key, 0, "", name, sizeof name)) return -1;
   if (!name[0]) return *out = def, 0;
   for (int i = 0; i < sc->nstage; ++i)
@@ -1133,7 +803,7 @@ static int find_stage(rd *r, const wf_node *map, const char *path, const char *k
     const size_t l = strlen(list);
     snprintf(list + l, sizeof list - l, "%s%s", i ? ", " : "", sc->stages[i].name);
   }
-  return fail_at(r, map_get(map, key), full, "no stage '%s' (stages: %s)", name, list);
+  return fail_at(r, wf_map_get(map, key), full, "no stage '%s' (stages: %s)", name, list);
 }
 
 /* metrics.hydrostatic_pressure_error: {surface: level of the free surface, stage: the stage
@@ -1162,7 +832,7 @@ static int read_hydrostatic(rd *r, const wf_node *v, const char *p, wf_scene *sc
 
 /* snapshot_plots: [{stage, times: [..], color, range: [lo, hi]}, ...] (snapshot_plots.c) */
 static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
-  const wf_node *ls = map_get(root, "snapshot_plots");
+  const wf_node *ls = wf_map_get(root, "snapshot_plots");
   if (!ls) return 0;
   if (ls->kind != WF_SEQ)
     return fail_at(r, ls, "snapshot_plots", "expected a list, e.g. - {stage: runout, times: [1, 2], color: eps_p}");
@@ -1181,17 +851,17 @@ static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
     if (check_map(r, n, p, keys)) return -1;
     if (find_stage(r, n, p, "stage", sc, 0, &sp->stage)) return -1;
     if (get_enum(r, n, p, "color", 0, WF_COLOR_MEAN_STRESS, wf_color_names, &sp->color)) return -1;
-    join(full, sizeof full, p, "color");
+    wf_key_join(full, sizeof full, p, "color");
     if (sp->color == WF_COLOR_EPS_P && !plastic)
-      return fail_at(r, map_get(n, "color"), full, "eps_p needs a plastic material (hencky_j2, mohr_coulomb, drucker_prager)");
-    sp->has_range = map_get(n, "range") != NULL;
+      return fail_at(r, wf_map_get(n, "color"), full, "eps_p needs a plastic material (hencky_j2, mohr_coulomb, drucker_prager)");
+    sp->has_range = wf_map_get(n, "range") != NULL;
     if (get_vec(r, n, p, "range", 0, 2, ANY, sp->range)) return -1;
-    join(full, sizeof full, p, "range");
+    wf_key_join(full, sizeof full, p, "range");
     if (sp->has_range && !(sp->range[1] > sp->range[0]))
-      return fail_at(r, map_get(n, "range"), full, "expected [lo, hi] with hi > lo (got [%g, %g])", sp->range[0],
+      return fail_at(r, wf_map_get(n, "range"), full, "expected [lo, hi] with hi > lo (got [%g, %g])", sp->range[0],
                      sp->range[1]);
-    const wf_node *t = map_get(n, "times");
-    join(full, sizeof full, p, "times");
+    const wf_node *t = wf_map_get(n, "times");
+    wf_key_join(full, sizeof full, p, "times");
     if (!t) return fail_at(r, n, full, "required key is missing");
     if (t->kind != WF_SEQ || t->n == 0 || t->n > 64) return fail_at(r, t, full, "expected a list of 1 to 64 times [s]");
     sp->times = calloc((size_t)t->n, sizeof *sp->times);
@@ -1213,12 +883,12 @@ static int read_snapplots(rd *r, const wf_node *root, wf_scene *sc) {
 
 /* water_table: {points: [[x, h], ...] | plane: [a, b, c], unit_weight: gamma_w} */
 static int read_water(rd *r, const wf_node *root, wf_scene *sc) {
-  const wf_node *w = map_get(root, "water_table");
+  const wf_node *w = wf_map_get(root, "water_table");
   if (!w) return 0;
   static const char *const keys[] = {"points", "plane", "unit_weight", NULL};
   if (check_map(r, w, "water_table", keys)) return -1;
   wf_water *wt = &sc->water;
-  const wf_node *pts = map_get(w, "points"), *pl = map_get(w, "plane");
+  const wf_node *pts = wf_map_get(w, "points"), *pl = wf_map_get(w, "plane");
   if (!pts == !pl)
     return fail_at(r, w, "water_table", "give the piezometric line as points: [[x, h], ...] or (3D) "
                    "plane: [a, b, c] for h = a + b x + c y, one of the two");
@@ -1241,7 +911,7 @@ static int read_water(rd *r, const wf_node *root, wf_scene *sc) {
 }
 
 static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
-  const wf_node *m = map_get(root, "metrics");
+  const wf_node *m = wf_map_get(root, "metrics");
   if (!m) return 0;
   static const char *const keys[] = {"runout_distance", "tip_displacement_y", "tip_displacement_x",
                                      "center_of_mass_x", "bearing_capacity_ratio", "surge_front_x",
@@ -1262,7 +932,7 @@ static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
       sc->metrics.runout_material = -1;
       if (empty) continue;
       if (check_map(r, v, p, rk)) return -1;
-      const wf_node *mn = map_get(v, "material");
+      const wf_node *mn = wf_map_get(v, "material");
       if (mn) { /* the slide's material (a foundation layer beyond the toe does not run out) */
         char full[160];
         snprintf(full, sizeof full, "%s.material", p);
@@ -1272,7 +942,7 @@ static int read_metrics(rd *r, const wf_node *root, wf_scene *sc) {
         if (sc->metrics.runout_material < 0)
           return fail_at(r, mn, full, "no material named '%s' in materials", mn->value);
       }
-      sc->metrics.has_toe = map_get(v, "toe") != NULL;
+      sc->metrics.has_toe = wf_map_get(v, "toe") != NULL;
       if (get_num(r, v, p, "toe", 0, 0, ANY, &sc->metrics.toe)) return -1;
       if (get_enum(r, v, p, "axis", 0, 0, axis_words, &sc->metrics.runout_axis)) return -1;
     } else if (!strncmp(m->keys[i], "tip_displacement", 16)) {
@@ -1308,9 +978,9 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   if (get_str(r, root, "", "scene", 0, def, sc->name, sizeof sc->name)) return -1;
   for (const char *c = sc->name; *c; ++c)
     if (!isalnum((unsigned char)*c) && *c != '_' && *c != '-')
-      return fail_at(r, map_get(root, "scene"), "scene", "use letters, digits, _ and - only (got '%s')", sc->name);
+      return fail_at(r, wf_map_get(root, "scene"), "scene", "use letters, digits, _ and - only (got '%s')", sc->name);
   if (get_int(r, root, "", "dim", 1, 2, 2, 3, &sc->dim)) return -1;
-  const wf_node *g = map_get(root, "grid");
+  const wf_node *g = wf_map_get(root, "grid");
   static const char *const gk[] = {"lo", "hi", "cell_size", NULL};
   if (!g) return fail_at(r, root, "grid", "required key is missing");
   if (check_map(r, g, "grid", gk)) return -1;
@@ -1318,18 +988,18 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
     return -1;
   for (int a = 0; a < sc->dim; ++a)
     if (sc->hi[a] <= sc->lo[a])
-      return fail_at(r, map_get(g, "hi"), "grid.hi", "component %d must be > grid.lo (%g) (got %g)", a,
+      return fail_at(r, wf_map_get(g, "hi"), "grid.hi", "component %d must be > grid.lo (%g) (got %g)", a,
                      sc->lo[a], sc->hi[a]);
   if (get_num(r, g, "grid", "cell_size", 1, 0, POS, &sc->h)) return -1;
   for (int a = 0; a < sc->dim; ++a)
     if (sc->h > sc->hi[a] - sc->lo[a])
-      return fail_at(r, map_get(g, "cell_size"), "grid.cell_size",
+      return fail_at(r, wf_map_get(g, "cell_size"), "grid.cell_size",
                      "must not exceed the grid's extent %g along axis %d (got %g)", sc->hi[a] - sc->lo[a], a, sc->h);
   if (get_enum(r, root, "", "basis", 0, MPMC_BASIS_BSPLINE2, basis_words, &sc->basis)) return -1;
   /* fbar: true (= anchored, the default), false, anchored, paper (Algorithm 1 as published),
    * total or stable (docs/theory.md) */
   {
-    const wf_node *fn = map_get(root, "fbar");
+    const wf_node *fn = wf_map_get(root, "fbar");
     static const char *const words[] = {"paper", "total", "stable", "anchored"};
     static const int modes[] = {MPMC_FBAR_PAPER, MPMC_FBAR_TOTAL, MPMC_FBAR_STABLE,
                                 MPMC_FBAR_ANCHORED};
@@ -1377,34 +1047,9 @@ int wf_scene_load(const char *path, int noverride, const char *const *overrides,
     *slash = '\0';
   else
     snprintf(sc->dir, sizeof sc->dir, ".");
-  FILE *f = fopen(path, "rb");
-  if (!f) {
-    snprintf(msg, msglen, "%s: cannot open the scene file: %s", path, strerror(errno));
-    return MPMC_ERR_IO;
-  }
-  size_t cap = 1 << 16, len = 0;
-  unsigned char *text = malloc(cap);
-  while (text) {
-    const size_t got = fread(text + len, 1, cap - len, f);
-    len += got;
-    if (len < cap) break;
-    unsigned char *t = realloc(text, cap * 2);
-    if (!t) {
-      free(text);
-      text = NULL;
-      break;
-    }
-    text = t;
-    cap *= 2;
-  }
-  fclose(f);
-  if (!text) {
-    snprintf(msg, msglen, "%s: out of memory", path);
-    return MPMC_ERR_MEMORY;
-  }
-  wf_node *root = parse_yaml(text, len, sc->path, msg, msglen);
-  free(text);
-  if (!root) return MPMC_ERR_FORMAT;
+  int code = 0;
+  wf_node *root = wf_yaml_load(sc->path, "scene file", &code, msg, msglen);
+  if (!root) return code;
   /* messages about overridden values name the --set argument */
   char **origins = calloc((size_t)noverride + 1, sizeof *origins);
   int err = origins ? 0 : MPMC_ERR_MEMORY;
@@ -1412,7 +1057,7 @@ int wf_scene_load(const char *path, int noverride, const char *const *overrides,
     const size_t l = overrides && overrides[i] ? strlen(overrides[i]) + 8 : 0;
     if (l) origins[i] = malloc(l);
     if (origins[i]) snprintf(origins[i], l, "--set %s", overrides[i]);
-    if (!origins[i] || apply_override(root, overrides[i], origins[i], msg, msglen)) {
+    if (!origins[i] || wf_yaml_override(root, overrides[i], origins[i], msg, msglen)) {
       if (!msg[0]) snprintf(msg, msglen, "--set: override %d is NULL", i);
       err = MPMC_ERR_ARG;
     }
@@ -1452,19 +1097,3 @@ void wf_scene_free(wf_scene *sc) {
   sc->stages = NULL;
   sc->mats = NULL;
 }
-
-/* ---- plain YAML access for the test driver (scene_check.c) ------------------------------ */
-/** @brief Parse a YAML (or JSON) file into a tree; NULL with a message on failure. */
-wf_node *wf_yaml_load(const char *path, char *msg, size_t len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) {
-    snprintf(msg, len, "%s: %s", path, strerror(errno));
-    return NULL;
-  }
-  static unsigned char buf[1 << 20];
-  const size_t n = fread(buf, 1, sizeof buf, f);
-  fclose(f);
-  return parse_yaml(buf, n, path, msg, len);
-}
-
-const wf_node *wf_map_get(const wf_node *map, const char *key) { return map_get(map, key); }

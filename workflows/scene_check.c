@@ -22,7 +22,8 @@ int main(int argc, char **argv) {
     return 2;
   }
   char msg[WF_MSG];
-  wf_node *exp = wf_yaml_load(argv[2], msg, sizeof msg);
+  int code = 0;
+  wf_node *exp = wf_yaml_load(argv[2], "expected-values file", &code, msg, sizeof msg);
   if (!exp) {
     fprintf(stderr, "%s\n", msg);
     return 1;
@@ -45,7 +46,7 @@ int main(int argc, char **argv) {
   mpmc_context_destroy(&ctx);
   char path[WF_PATH + 32];
   snprintf(path, sizeof path, "%s/summary.json", argv[3]);
-  wf_node *sum = wf_yaml_load(path, msg, sizeof msg);
+  wf_node *sum = wf_yaml_load(path, "summary", &code, msg, sizeof msg);
   if (!sum) {
     fprintf(stderr, "%s\n", msg);
     return 1;

@@ -1,7 +1,7 @@
 /* Private declarations of the workflow front end (libmpmc_workflow).  Not installed.
  *
- * scene.c    YAML -> a small tree with file:line:column on every node, --set overrides,
- *            typed and range-checked reading of that tree into wf_scene
+ * yaml.c     YAML -> a small tree with file:line:column on every node, --set overrides
+ * scene.c    the scene schema: typed and range-checked reading of that tree into wf_scene
  * run.c      mpmc_workflow_run: builds the simulation and runs the stages (calls report.c)
  * report.c   progress line/bar, series.csv, summary.json, metrics (calls nothing in run.c)
  * plot.c     PNG plots through gnuplot (a child process; its start and end, wf_gnuplot_*,
@@ -21,7 +21,7 @@
 #define WF_PATH 4096
 #define WF_MSG 4096
 
-/* ---- the YAML tree (scene.c) ----------------------------------------------------- */
+/* ---- the YAML tree (yaml.c) ------------------------------------------------------ */
 typedef enum { WF_SCALAR = 0, WF_SEQ = 1, WF_MAP = 2 } wf_kind;
 typedef struct wf_node {
   wf_kind kind;
@@ -36,7 +36,11 @@ typedef struct wf_node {
 } wf_node;
 
 void wf_node_free(wf_node *n);
-wf_node *wf_yaml_load(const char *path, char *msg, size_t len);
+/* yaml.c: a YAML (or JSON) file as a tree, NULL with *code and msg; one --set override
+ * applied to a tree (origin, named in messages, must outlive it); a map's value by key */
+wf_node *wf_yaml_load(const char *path, const char *what, int *code, char *msg, size_t len);
+int wf_yaml_override(wf_node *root, const char *arg, const char *origin, char *msg, size_t len);
+void wf_key_join(char *out, size_t len, const char *path, const char *key);
 const wf_node *wf_map_get(const wf_node *map, const char *key);
 
 /* ---- the scene as read (scene.c) ------------------------------------------------- */
