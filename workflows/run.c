@@ -48,16 +48,7 @@ static int last_code(mpmc_context ctx) {
   return code;
 }
 
-/* Where a stage stands between two steps: what a checkpoint inside the stage records so that
- * the resumed stage takes the same steps as the uninterrupted one (the step size is computed
- * every 10 steps counted from the stage's start, and kept in between; the next series row and
- * snapshot are running sums). */
-typedef struct {
-  double t_stage;     /* time into the stage                                            */
-  double dt;          /* the step last computed (0: compute it on the next step)        */
-  double ke, ke_max, ratio;   /* kinetic energy, its stage maximum, their ratio         */
-  double next_series, next_snap; /* stage times of the next row and snapshot (0: derive) */
-} stage_clock;
+typedef wf_clock stage_clock;
 
 typedef struct {
   mpmc_context ctx;
@@ -480,26 +471,18 @@ static int snapshot(wf_run *w) {
 #ifdef MPMC_WF_HAVE_CHECKPOINT
 /* At the start of `stage` (c == NULL: before its setup) or inside it (c: where it stands). */
 static int checkpoint(wf_run *w, int stage, const stage_clock *c, long steps) {
-  char path[WF_PATH], meta[16384], scene[WF_PATH];
+  char path[WF_PATH], meta[16384];
   const stage_clock c0 = {0};
   const int setup_done = c != NULL;
   if (!c) c = &c0;
   out_path(w, "checkpoint.h5", path, sizeof path);
+  wf_record r = {.stage = stage, .setup = setup_done, .clock = *c, .steps = steps,
+                 .ke_below = setup_done ? w->ke_below : -1.0, .strength = w->strength,
+                 .nset = w->noverride, .sets = (char **)w->overrides, .nwall = w->nwall_ids,
+                 .walls = w->wall_ids, .ndone = stage, .done = w->rec};
   /* the absolute path, so that `mpmc resume` works from any directory */
-  if (!realpath(w->sc.path, scene)) snprintf(scene, sizeof scene, "%s", w->sc.path);
-  size_t l = (size_t)snprintf(meta, sizeof meta, "mpmc-workflow 1\nscene %s\nstage %d\nsetup %d\nstage_time %.17g\n"
-                              "stage_steps %ld\nke_max %.17g\nke_below %.17g\nstrength %.17g\ndt %.17g\nke %.17g\n"
-                              "ratio %.17g\nnext_series %.17g\nnext_snap %.17g\n", scene, stage, setup_done,
-                              c->t_stage, steps, c->ke_max, setup_done ? w->ke_below : -1.0, w->strength, c->dt, c->ke,
-                              c->ratio, c->next_series, c->next_snap);
-  for (int i = 0; i < w->noverride && l < sizeof meta; ++i)
-    l += (size_t)snprintf(meta + l, sizeof meta - l, "set %s\n", w->overrides[i]);
-  for (int i = 0; i < w->nwall_ids && l < sizeof meta; ++i)
-    l += (size_t)snprintf(meta + l, sizeof meta - l, "wall %d\n", w->wall_ids[i]);
-  for (int i = 0; i < stage && l < sizeof meta; ++i)
-    l += (size_t)snprintf(meta + l, sizeof meta - l, "done %.17g %ld %.17g %s %.17g\n", w->rec[i].sim_time,
-                          w->rec[i].steps, w->rec[i].wall_seconds, w->rec[i].reason, w->rec[i].strength);
-  if (l >= sizeof meta) return fail(w, MPMC_ERR_MEMORY, "checkpoint: too many overrides to record");
+  if (!realpath(w->sc.path, r.scene)) snprintf(r.scene, sizeof r.scene, "%s", w->sc.path);
+  if (wf_record_format(&r, meta, sizeof meta)) return fail(w, MPMC_ERR_MEMORY, "checkpoint: too many overrides to record");
   WF_TRY(w, mpmc_sim_checkpoint_write(w->sim, path, meta), "checkpoint %s", path);
   w->ckpt_ok = 1;
   mpmc_sim_get_time(w->sim, &w->ckpt_time);
@@ -870,75 +853,29 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   mpmc_sim sim = NULL;
   char *meta = NULL;
   WF_CALL(mpmc_sim_checkpoint_read(ctx, path, &sim, &meta));
-  /* parse the workflow's record */
-  char scene[WF_PATH] = "";
-  int stage = -1, setup = 0, nset = 0, nwall = 0, ndone = 0;
-  double strength = 1, ke_below = -1;
-  stage_clock clock = {.ratio = 1.0};
-  long steps = 0;
-  char **sets = calloc(1, sizeof *sets);
-  int *walls = NULL;
-  wf_stage_record *done = NULL;
-  int bad = meta == NULL || strncmp(meta, "mpmc-workflow 1\n", 16) != 0;
-  for (char *save = NULL, *line = bad ? NULL : strtok_r(meta, "\n", &save); line && !bad;
-       line = strtok_r(NULL, "\n", &save)) {
-    if (!strncmp(line, "scene ", 6))
-      snprintf(scene, sizeof scene, "%s", line + 6);
-    else if (sscanf(line, "stage %d", &stage) == 1 || sscanf(line, "setup %d", &setup) == 1 ||
-             sscanf(line, "stage_time %lf", &clock.t_stage) == 1 || sscanf(line, "stage_steps %ld", &steps) == 1 ||
-             sscanf(line, "ke_max %lf", &clock.ke_max) == 1 || sscanf(line, "strength %lf", &strength) == 1 ||
-             sscanf(line, "ke_below %lf", &ke_below) == 1 || sscanf(line, "dt %lf", &clock.dt) == 1 ||
-             sscanf(line, "ke %lf", &clock.ke) == 1 || sscanf(line, "ratio %lf", &clock.ratio) == 1 ||
-             sscanf(line, "next_series %lf", &clock.next_series) == 1 ||
-             sscanf(line, "next_snap %lf", &clock.next_snap) == 1)
-      continue;
-    else if (!strncmp(line, "set ", 4)) {
-      char **s2 = realloc(sets, sizeof *sets * (size_t)(nset + 1));
-      bad = !s2;
-      if (s2) (sets = s2)[nset++] = strdup(line + 4);
-    } else if (!strncmp(line, "wall ", 5)) {
-      int *w2 = realloc(walls, sizeof *walls * (size_t)(nwall + 1));
-      bad = !w2;
-      if (w2) bad = sscanf(line, "wall %d", &(walls = w2)[nwall++]) != 1;
-    } else if (!strncmp(line, "done ", 5)) {
-      wf_stage_record *d2 = realloc(done, sizeof *done * (size_t)(ndone + 1));
-      bad = !d2;
-      if (d2) {
-        done = d2;
-        char reason[32];
-        wf_stage_record *r = &done[ndone++];
-        memset(r, 0, sizeof *r);
-        bad = sscanf(line, "done %lf %ld %lf %31s %lf", &r->sim_time, &r->steps, &r->wall_seconds, reason,
-                     &r->strength) != 5;
-        r->reason = !strcmp(reason, "quasi_static") ? "quasi_static"
-                    : !strcmp(reason, "time")       ? "time"
-                    : !strcmp(reason, "fos")        ? "fos"
-                                                    : "max_time";
-      }
-    }
-  }
+  /* the workflow's record */
+  wf_record rec;
+  char why[WF_MSG] = "";
+  int bad = wf_record_parse(meta, &rec, why, sizeof why) != 0;
   mpmc_free(meta);
-  for (int i = 0; i < noverride && !bad; ++i) { /* the caller's, after the run's own */
-    char **s2 = realloc(sets, sizeof *sets * (size_t)(nset + 1));
-    bad = !s2 || !((sets = s2)[nset] = strdup(overrides[i]));
-    nset += !bad;
-  }
+  for (int i = 0; i < noverride && !bad; ++i) /* the caller's, after the run's own */
+    bad = wf_record_add_set(&rec, overrides[i]) != 0;
   int err = 0;
   wf_run w = {0};
   w.ctx = ctx;
   w.quiet = (flags & MPMC_WORKFLOW_QUIET) != 0;
   w.t_start = wf_now();
-  w.noverride = nset;
-  w.overrides = (const char *const *)sets;
+  w.noverride = rec.nset;
+  w.overrides = (const char *const *)rec.sets;
   /* the walls the checkpoint records: those of its stages, or of more (not yet added) */
   int walls_before = 0; /* of the stages up to the one resumed */
-  if (bad || stage < 0 || !scene[0]) {
-    err = WF_ERROR(ctx, MPMC_ERR_FORMAT, "resume: %s was not written by the workflow (no stage record)", path);
-  } else if (prepare(&w, scene, nset, w.overrides)) {
+  if (bad || rec.stage < 0 || !rec.scene[0]) {
+    err = WF_ERROR(ctx, MPMC_ERR_FORMAT, "resume: %s was not written by the workflow (%s)", path, why);
+  } else if (prepare(&w, rec.scene, rec.nset, w.overrides)) {
     err = last_code(ctx);
   } else {
     /* a stage's walls are added by its setup */
-    for (int i = 0; i < stage + (setup != 0) && i < w.sc.nstage; ++i) walls_before += w.sc.stages[i].nwalls;
+    for (int i = 0; i < rec.stage + (rec.setup != 0) && i < w.sc.nstage; ++i) walls_before += w.sc.stages[i].nwalls;
   }
   /* errors before this point leave the outputs as they are (w.out empty: finish writes no
    * summary); a finished run is not a failed one */
@@ -947,17 +884,17 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   /* A finished run (the checkpoint after its last stage) continues with the stages added to
    * the scene since, or its last stage from where it ended when that stage's end time was
    * raised (an end by time; not one that came to rest) */
-  if (!err && stage == w.sc.nstage && ndone == stage && stage > 0) {
-    const wf_stage *last = &w.sc.stages[stage - 1];
-    const wf_stage_record *r = &done[stage - 1];
+  if (!err && rec.stage == w.sc.nstage && rec.ndone == rec.stage && rec.stage > 0) {
+    const wf_stage *last = &w.sc.stages[rec.stage - 1];
+    const wf_stage_record *r = &rec.done[rec.stage - 1];
     if (strcmp(r->reason, "quasi_static") != 0 && last->end_time > r->sim_time * (1 + 1e-9)) {
       /* the last stage again, at its old end, set up; ke_max is used by quasi-static ends
        * only, the step size is computed on the first step */
-      clock = (stage_clock){.t_stage = r->sim_time, .ratio = 1.0};
-      --stage;
-      --ndone;
-      setup = 1;
-      ke_below = -1.0;
+      rec.clock = (stage_clock){.t_stage = r->sim_time, .ratio = 1.0};
+      --rec.stage;
+      --rec.ndone;
+      rec.setup = 1;
+      rec.ke_below = -1.0;
     } else {
       char how[WF_PATH + 160] = "";
       if (strcmp(r->reason, "quasi_static"))
@@ -967,24 +904,24 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
       err = fail(&w, MPMC_ERR_STATE,
                  "resume: the run in %s finished all %d stages of %s (checkpoint at t = %.6g s, stage '%s' "
                  "ended by %s at %.6g s); to continue it, add a stage to the scene%s",
-                 outdir, stage, scene, t_ckpt, last->name, r->reason, r->sim_time, how);
+                 outdir, rec.stage, rec.scene, t_ckpt, last->name, r->reason, r->sim_time, how);
     }
   }
-  if (!err && (nwall < walls_before || nwall > w.nwall_ids || ndone != stage || stage > w.sc.nstage)) {
+  if (!err && (rec.nwall < walls_before || rec.nwall > w.nwall_ids || rec.ndone != rec.stage || rec.stage > w.sc.nstage)) {
     err = fail(&w, MPMC_ERR_FORMAT,
                "resume: the scene %s no longer matches the checkpoint (stages or walls changed: %d stages "
                "done, %d walls recorded; the scene has %d stages, %d walls)",
-               scene, ndone, nwall, w.sc.nstage, w.nwall_ids);
+               rec.scene, rec.ndone, rec.nwall, w.sc.nstage, w.nwall_ids);
   } else if (!err) {
     snprintf(w.out, sizeof w.out, "%s", outdir);
-    if (nwall) memcpy(w.wall_ids, walls, sizeof *walls * (size_t)nwall);
-    for (int i = 0; i < ndone; ++i) {
-      w.rec[i] = done[i];
+    if (rec.nwall) memcpy(w.wall_ids, rec.walls, sizeof *rec.walls * (size_t)rec.nwall);
+    for (int i = 0; i < rec.ndone; ++i) {
+      w.rec[i] = rec.done[i];
       snprintf(w.rec[i].name, sizeof w.rec[i].name, "%s", w.sc.stages[i].name);
     }
     /* a finished search is not run again: its answer comes back from fos_trials.csv */
-    for (int i = 0; i < ndone && !err; ++i) {
-      if (strcmp(done[i].reason, "fos") || !w.sc.stages[i].has_fos) continue;
+    for (int i = 0; i < rec.ndone && !err; ++i) {
+      if (strcmp(rec.done[i].reason, "fos") || !w.sc.stages[i].has_fos) continue;
       char trials[WF_PATH], msg[WF_MSG];
       out_path(&w, "fos_trials.csv", trials, sizeof trials);
       if (!w.fos && !(w.fos = calloc(1, sizeof *w.fos))) {
@@ -1001,39 +938,36 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     w.sim = sim;
     w.ckpt_ok = 1; /* the checkpoint resumed from is the last good state until the next one */
     w.ckpt_time = t_ckpt;
-    w.strength = strength;
-    w.ke_below = ke_below;
+    w.strength = rec.strength;
+    w.ke_below = rec.ke_below;
     set_threads(&w);
     mpmc_sim_set_threads(w.sim, w.sc.threads);
     sim = NULL;
     if (wf_metrics_init(w.sim, &w.sc)) err = last_code(ctx);
-    say(&w, "resuming %s at stage %d/%d (%s), %.4g s into it", scene, stage + 1, w.sc.nstage,
-        w.sc.stages[stage].name, clock.t_stage);
+    say(&w, "resuming %s at stage %d/%d (%s), %.4g s into it", rec.scene, rec.stage + 1, w.sc.nstage,
+        w.sc.stages[rec.stage].name, rec.clock.t_stage);
     if (!err) {
       char series[WF_PATH], msg[WF_MSG];
       out_path(&w, "series.csv", series, sizeof series);
-      if (wf_series_trim(series, &w.sc, steps, &w.series_rows, msg, sizeof msg))
+      if (wf_series_trim(series, &w.sc, rec.steps, &w.series_rows, msg, sizeof msg))
         err = fail(&w, MPMC_ERR_IO, "resume: %s", msg);
     }
     if (!err) err = open_outputs(&w, 1) ? last_code(ctx) : 0;
     if (!err) {
-      if (setup && w.sc.stages[stage].has_gravity) mpmc_sim_set_gravity(w.sim, w.sc.stages[stage].gravity);
-      if (setup) {
-        const wf_stage *s = &w.sc.stages[stage];
+      if (rec.setup && w.sc.stages[rec.stage].has_gravity) mpmc_sim_set_gravity(w.sim, w.sc.stages[rec.stage].gravity);
+      if (rec.setup) {
+        const wf_stage *s = &w.sc.stages[rec.stage];
         mpmc_sim_set_damping(w.sim, s->damping);
         mpmc_sim_set_kinetic_damping(w.sim, s->kinetic_damping);
         mpmc_sim_set_adaptive_damping(w.sim, s->adaptive_damping);
         mpmc_sim_set_flip_blend(w.sim, s->flip);
       }
-      err = run_all(&w, stage, &clock, steps, setup) ? last_code(ctx) : 0;
+      err = run_all(&w, rec.stage, &rec.clock, rec.steps, rec.setup) ? last_code(ctx) : 0;
     }
   }
   mpmc_sim_destroy(&sim);
   err = finish(&w, err);
-  for (int i = 0; i < nset; ++i) free(sets[i]);
-  free(sets);
-  free(walls);
-  free(done);
+  wf_record_free(&rec);
   return err;
 #endif
 }

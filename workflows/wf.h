@@ -240,6 +240,40 @@ typedef struct {
   double strength;           /* the strength reduction factor in force at its end (1: none) */
 } wf_stage_record;
 
+/* ---- the workflow's record in a checkpoint (record.c) ---------------------------------- */
+/* Where a stage stands between two steps: what a checkpoint inside the stage records so that
+ * the resumed stage takes the same steps as the uninterrupted one (the step size is computed
+ * every 10 steps counted from the stage's start, and kept in between; the next series row and
+ * snapshot are running sums). */
+typedef struct {
+  double t_stage;     /* time into the stage                                            */
+  double dt;          /* the step last computed (0: compute it on the next step)        */
+  double ke, ke_max, ratio;   /* kinetic energy, its stage maximum, their ratio         */
+  double next_series, next_snap; /* stage times of the next row and snapshot (0: derive) */
+} wf_clock;
+/* Where the run stands: the checkpoint's metadata, as text ("mpmc-workflow 1" and one
+ * "key value" line each), which `mpmc resume` reads back. */
+typedef struct {
+  char scene[WF_PATH];       /* the scene file, absolute                                */
+  int stage;                 /* the stage to run (nstage: the run is finished)          */
+  int setup;                 /* 1: inside the stage, which is set up already             */
+  wf_clock clock;            /* with setup                                              */
+  long steps;                /* steps of the stage so far                               */
+  double ke_below;           /* the quasi-static test's hold (-1: above)                */
+  double strength;           /* the strength reduction factor in force                  */
+  int nset, nwall, ndone;
+  char **sets;               /* the run's --set overrides [nset]                        */
+  int *walls;                /* the library's ids of the scene's walls added [nwall]    */
+  wf_stage_record *done;     /* the finished stages [ndone]; reason a static string     */
+} wf_record;
+/* r as text into buf; 0, or -1 when it does not fit */
+int wf_record_format(const wf_record *r, char *buf, size_t len);
+/* text (a checkpoint's metadata; NULL: none) into r, which the caller frees with
+ * wf_record_free; 0, MPMC_ERR_FORMAT (not a workflow's record, msg says why) or MPMC_ERR_MEMORY */
+int wf_record_parse(const char *text, wf_record *r, char *msg, size_t len);
+int wf_record_add_set(wf_record *r, const char *set); /* 0 or MPMC_ERR_MEMORY */
+void wf_record_free(wf_record *r);
+
 /* ---- the factor-of-safety search (fos.c) ------------------------------------------ */
 #define WF_FOS_MAX_JOBS 16 /* factor_of_safety.jobs at most */
 typedef struct {
