@@ -552,9 +552,9 @@ static inline int mpmc_stress_finite(const double *s) {
   return isfinite(s[0] + s[1] + s[2] + s[3] + s[4] + s[5]);
 }
 /* 1 if this build carries the AVX2 kernels (avx2 and fma) and the processor (and OS) runs
- * them (sim.c) */
+ * them (kernels.c) */
 int mpmc_kernels_avx2_available(void);
-/* 1 if the AVX-512 kernels (avx512) can run here likewise (sim.c) */
+/* 1 if the AVX-512 kernels (avx512) can run here likewise (kernels.c) */
 int mpmc_kernels_avx512_available(void);
 
 /* sort.c: before a step, sort the points by cell if the sort interval has passed */

@@ -177,7 +177,7 @@ MPMC_J2_BATCH_PROTOTYPE(_avx2)
 MPMC_J2_BATCH_PROTOTYPE(_fma)
 MPMC_J2_BATCH_PROTOTYPE(_avx512)
 #endif
-/* The sim's set of it (step.c's kernel table, sim->kernels), which material_hencky_j2.c runs. */
+/* The sim's set of it (kernels.c's table, sim->kernels), which material_hencky_j2.c runs. */
 typedef int (*mpmc_j2_batch_fn)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                                 mpmc_rm_ws **ws, int64_t *nret, int64_t *nfb, int *first_bad);
 mpmc_j2_batch_fn mpmc_kernels_j2_batch(const struct mpmc_sim_s *sim);

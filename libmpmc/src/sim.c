@@ -6,88 +6,8 @@
 #include <omp.h>
 #endif
 
-#include "mpmc_impl.h"
+#include "kernels.h"
 #include "sets.h"
-
-int mpmc_kernels_avx2_available(void) {
-#if defined(MPMC_HAVE_AVX2_KERNELS)
-  /* x86-64-v3 is AVX2, BMI1/2, FMA, F16C, LZCNT, MOVBE: every processor with AVX2 and BMI2
-   * has the others too (clang 14's builtin knows no "x86-64-v3").  The "avx" check includes
-   * that the OS saves the AVX state. */
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx") && __builtin_cpu_supports("avx2") &&
-         __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-         __builtin_cpu_supports("bmi2");
-#else
-  return 0;
-#endif
-}
-
-int mpmc_kernels_avx512_available(void) {
-#if defined(MPMC_HAVE_AVX2_KERNELS)
-  /* x86-64-v4 adds AVX-512 F, BW, CD, DQ and VL to x86-64-v3; the "avx512f" check includes
-   * that the OS saves the AVX-512 state */
-  return mpmc_kernels_avx2_available() && __builtin_cpu_supports("avx512f") &&
-         __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512cd") &&
-         __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
-#else
-  return 0;
-#endif
-}
-
-/* Why the kernels of the request cannot run here (for the messages). */
-static const char *kernels_missing(int request) {
-#if defined(MPMC_HAVE_AVX2_KERNELS)
-  if (request == MPMC_KERNELS_AVX512 && mpmc_kernels_avx2_available())
-    return "this processor has no AVX-512 (x86-64-v4: AVX-512 F, BW, CD, DQ and VL)";
-  return "this processor has no AVX2 (x86-64-v3)";
-#else
-  (void)request;
-  return "this build has no AVX2 or AVX-512 kernels (not x86-64, or MPMC_ARCH set)";
-#endif
-}
-
-/* Take a valid request (mpmc_kernels): AVX2, FMA and AVX512 are refused where they cannot
- * run, the message naming the request as `what` says; AUTO becomes AVX512 where AVX-512 is
- * available, else FMA where AVX2 is, else BASELINE. */
-static int use_kernels(mpmc_sim s, int request, const char *what) {
-  const int avx2 = mpmc_kernels_avx2_available(), avx512 = mpmc_kernels_avx512_available();
-  const int ok = request == MPMC_KERNELS_AUTO || request == MPMC_KERNELS_BASELINE ||
-                 (request == MPMC_KERNELS_AVX512 ? avx512 : avx2);
-  MPMC_CHECK(ok, s->ctx, MPMC_ERR_ARG, "%s: %s", what, kernels_missing(request));
-  s->kernels = request != MPMC_KERNELS_AUTO ? request
-               : avx512                     ? MPMC_KERNELS_AVX512
-               : avx2                       ? MPMC_KERNELS_FMA
-                                            : MPMC_KERNELS_BASELINE;
-  return MPMC_SUCCESS;
-}
-
-/**
- * @brief The name of a kernel set (mpmc_kernels) as MPMC_KERNELS and summary.json spell it,
- *        a static string.
- */
-const char *mpmc_kernels_name(int kernels) {
-  static const char *const names[] = {"auto", "baseline", "avx2", "fma", "avx512"};
-  return kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_AVX512 ? names[kernels]
-                                                                        : "unknown kernel set";
-}
-
-/* The default set, or the one MPMC_KERNELS names (auto, baseline, avx2, fma, avx512). */
-static int kernels_from_env(mpmc_sim s) {
-  const char *e = getenv("MPMC_KERNELS");
-  int req = MPMC_KERNELS_AUTO;
-  if (e && *e) {
-    req = -1;
-    for (int k = MPMC_KERNELS_AUTO; k <= MPMC_KERNELS_AVX512; ++k)
-      if (!strcmp(e, mpmc_kernels_name(k))) req = k;
-    MPMC_CHECK(req >= 0, s->ctx, MPMC_ERR_ARG,
-               "environment variable MPMC_KERNELS = '%.40s' is not one of auto, baseline, avx2, "
-               "fma, avx512", e);
-  }
-  char what[64];
-  snprintf(what, sizeof what, "environment variable MPMC_KERNELS = %s", mpmc_kernels_name(req));
-  return use_kernels(s, req, what);
-}
 
 /**
  * @brief Create a simulation in dim = 2 (plane strain) or 3 dimensions.
@@ -107,7 +27,7 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
   s->sort_last = -1;
   s->sort_axis = -1;
   s->p.dim = dim;
-  const int err = kernels_from_env(s);
+  const int err = mpmc_kernels_from_env(s);
   if (err) {
     free(s);
     return err;
@@ -310,34 +230,6 @@ int mpmc_sim_set_threads(mpmc_sim sim, int nthreads) {
   MPMC_CHECK(nthreads >= 0 && nthreads <= 1024, sim->ctx, MPMC_ERR_ARG,
              "threads = %d must be in [0, 1024]", nthreads);
   sim->nthreads = nthreads;
-  return MPMC_SUCCESS;
-}
-
-/**
- * @brief Instruction set of the step's transfer kernels (mpmc_kernels).  BASELINE and AVX2
- * give the same results to the bit, FMA (fused multiply-adds) differs from them by round-off,
- * AVX512 (FMA for AVX-512, the fastest) gives FMA's bits; AUTO (the default) takes AVX512
- * where the processor has AVX-512, else FMA where it has AVX2.
- * @param kernels MPMC_KERNELS_AUTO, _BASELINE, _AVX2, _FMA or _AVX512 (MPMC_ERR_ARG for AVX2
- *        and FMA where this build or processor has no AVX2 kernels, for AVX512 where it has
- *        no AVX-512 ones)
- */
-int mpmc_sim_set_kernels(mpmc_sim sim, int kernels) {
-  if (!sim) return MPMC_ERR_ARG;
-  MPMC_CHECK(kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_AVX512, sim->ctx,
-             MPMC_ERR_ARG,
-             "kernels = %d is not one of auto (0), baseline (1), avx2 (2), fma (3), avx512 (4)",
-             kernels);
-  char what[32];
-  snprintf(what, sizeof what, "kernels = %s (%d)", mpmc_kernels_name(kernels), kernels);
-  return use_kernels(sim, kernels, what);
-}
-
-/** @brief The kernel set the step runs: MPMC_KERNELS_BASELINE, _AVX2, _FMA or _AVX512. */
-int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels) {
-  if (!sim) return MPMC_ERR_ARG;
-  MPMC_CHECK(kernels, sim->ctx, MPMC_ERR_ARG, "kernels pointer is NULL");
-  *kernels = sim->kernels;
   return MPMC_SUCCESS;
 }
 

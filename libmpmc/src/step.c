@@ -5,60 +5,12 @@
 #endif
 #include <time.h>
 
-#include "mpmc_impl.h"
-#include "return_map.h"
+#include "kernels.h"
 
 static double now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* The kernel phases for each instruction set (mpmc_impl.h, mpmc_sim_set_kernels), and the
- * Hencky-J2, Neo-Hookean, Hencky and Newtonian updates' blocks (stress_j2.c,
- * stress_blocks.c), which the materials run in the sim's set. */
-typedef struct {
-  int (*slabs)(mpmc_sim);
-  int (*p2g)(mpmc_sim, double);
-  int (*grid_update)(mpmc_sim, double);
-  int (*g2p)(mpmc_sim, double);
-  int (*fbar)(mpmc_sim, int);
-  mpmc_j2_batch_fn j2_batch;
-  mpmc_stress_batch_fn nh_batch, hencky_batch, newtonian_batch;
-} kernel_set;
-static const kernel_set baseline = {mpmc_slabs_build, mpmc_p2g, mpmc_grid_update, mpmc_g2p,
-                                    mpmc_fbar, mpmc_j2_batch, mpmc_nh_batch,
-                                    mpmc_hencky_batch, mpmc_newtonian_batch};
-#ifdef MPMC_HAVE_AVX2_KERNELS
-static const kernel_set avx2 = {mpmc_slabs_build_avx2, mpmc_p2g_avx2, mpmc_grid_update_avx2,
-                                mpmc_g2p_avx2, mpmc_fbar_avx2, mpmc_j2_batch_avx2,
-                                mpmc_nh_batch_avx2, mpmc_hencky_batch_avx2,
-                                mpmc_newtonian_batch_avx2};
-static const kernel_set fused = {mpmc_slabs_build_fma, mpmc_p2g_fma, mpmc_grid_update_fma,
-                                 mpmc_g2p_fma, mpmc_fbar_fma, mpmc_j2_batch_fma,
-                                 mpmc_nh_batch_fma, mpmc_hencky_batch_fma,
-                                 mpmc_newtonian_batch_fma};
-static const kernel_set avx512 = {mpmc_slabs_build_avx512, mpmc_p2g_avx512,
-                                  mpmc_grid_update_avx512, mpmc_g2p_avx512, mpmc_fbar_avx512,
-                                  mpmc_j2_batch_avx512, mpmc_nh_batch_avx512,
-                                  mpmc_hencky_batch_avx512, mpmc_newtonian_batch_avx512};
-#define KERNELS(sim)                                  \
-  ((sim)->kernels == MPMC_KERNELS_AVX512 ? &avx512   \
-   : (sim)->kernels == MPMC_KERNELS_FMA  ? &fused    \
-   : (sim)->kernels == MPMC_KERNELS_AVX2 ? &avx2     \
-                                         : &baseline)
-#else
-#define KERNELS(sim) (&baseline)
-#endif
-
-mpmc_j2_batch_fn mpmc_kernels_j2_batch(const struct mpmc_sim_s *sim) {
-  return KERNELS(sim)->j2_batch;
-}
-
-mpmc_stress_batch_fn mpmc_kernels_stress_batch(const struct mpmc_sim_s *sim, int model) {
-  return model == MPMC_BATCH_NEWTONIAN ? KERNELS(sim)->newtonian_batch
-         : model == MPMC_BATCH_HENCKY  ? KERNELS(sim)->hencky_batch
-                                     : KERNELS(sim)->nh_batch;
 }
 
 /* The name of a local solver (mpmc_solver) for messages: "auto", "newton" or "kinsol". */
@@ -93,7 +45,7 @@ static void lap(mpmc_sim sim, int ph, double *t) {
   } while (0)
 
 static int step_phases(mpmc_sim sim, double dt, double *t) {
-  const kernel_set *k = KERNELS(sim);
+  const mpmc_kernel_set *k = mpmc_kernels_of(sim);
   if (sim->bodies) PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_update(sim, dt)); /* barrier forces */
   mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
   PHASE(sim, MPMC_PHASE_SLABS, t, k->slabs(sim));     /* this step's box, P2G's colouring */
