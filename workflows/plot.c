@@ -10,20 +10,20 @@
 
 #include "wf.h"
 
-typedef struct {
-  double depth;
-  int q;
-} depth_idx;
-
-static int by_depth(const void *a, const void *b) {
-  const double da = ((const depth_idx *)a)->depth, db = ((const depth_idx *)b)->depth;
-  return da < db ? 1 : da > db ? -1 : 0; /* far points first, near points drawn last */
+/** @brief qsort order of wf_depth_idx: far points (large depth) first, near ones drawn last. */
+int wf_by_depth(const void *a, const void *b) {
+  const double da = ((const wf_depth_idx *)a)->depth, db = ((const wf_depth_idx *)b)->depth;
+  return da < db ? 1 : da > db ? -1 : 0;
 }
 
-/* The vertical axis: the largest gravity component of the last stage that sets gravity. */
-static int vertical_axis(const wf_scene *sc) {
-  int v = 1;
-  for (int i = 0; i < sc->nstage; ++i) {
+/**
+ * @brief The plots' axes: vy the vertical (2D: y; 3D: the largest gravity component of the
+ *        stages that set gravity, z without), hx the horizontal (the run-out axis, else x, or
+ *        y when x is vertical).
+ */
+void wf_view_axes(const wf_scene *sc, int *hx, int *vy) {
+  int v = sc->dim == 2 ? 1 : 2;
+  for (int i = 0; i < sc->nstage && sc->dim == 3; ++i) {
     if (!sc->stages[i].has_gravity) continue;
     double best = 0;
     for (int a = 0; a < sc->dim; ++a)
@@ -32,14 +32,32 @@ static int vertical_axis(const wf_scene *sc) {
         v = a;
       }
   }
-  return v;
+  *vy = v;
+  *hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
+  if (*hx == *vy) *hx = *vy == 0 ? 1 : 0;
 }
 
-static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int hx, int vy, int *has_eps) {
-  int np;
-  double *x, *x0, *sig, *eps = NULL;
-  mpmc_sim_get_num_particles(sim, &np);
-  if (mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) || mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL) ||
+/* The phreatic line over the grid's width as gnuplot's $water table, where the view is along
+ * x (a polyline water table); the plot clause that draws it, or "". */
+static const char *water_line(FILE *g, const wf_scene *sc, int hx) {
+  if (!sc->water.n || hx != 0) return "";
+  const wf_water *wt = &sc->water;
+  fprintf(g, "$water << EOD\n%.9g,%.9g\n", sc->lo[0], wt->xh[1]);
+  for (int k = 0; k < wt->n; ++k) fprintf(g, "%.9g,%.9g\n", wt->xh[2 * k], wt->xh[2 * k + 1]);
+  fprintf(g, "%.9g,%.9g\nEOD\n", sc->hi[0], wt->xh[2 * wt->n - 1]);
+  return ", $water using 1:2 with lines lw 2 lc rgb '#1f78b4' title 'water table'";
+}
+
+/* The points' state in final_state.csv's columns into path, far points first in 3D (looking
+ * along the axis other than hx and vy); the displacement from the initial positions, or with
+ * xs from xs (positions by point id).  *has_eps: an eps_p column with values.  0, or -1. */
+static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int hx, int vy, const double *xs,
+                       int *has_eps) {
+  int np = 0;
+  double *x, *x0 = NULL, *sig, *eps = NULL;
+  const int *ids = NULL;
+  if (mpmc_sim_get_num_particles(sim, &np) || mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
+      (xs ? mpmc_sim_get_particle_ids(sim, &ids) : mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
       mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
     return -1;
   int plastic = 0;
@@ -53,7 +71,7 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
   double *pw = NULL;
   if ((!sc->water.n && !sc->water.has_plane) || mpmc_sim_get_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
   const int d = sc->dim;
-  depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
+  wf_depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
   FILE *f = fopen(path, "w");
   if (!order || !f) {
     free(order);
@@ -65,15 +83,16 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
     order[q].q = q;
     order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
   }
-  if (d == 3) qsort(order, (size_t)np, sizeof *order, by_depth);
+  if (d == 3) qsort(order, (size_t)np, sizeof *order, wf_by_depth);
   fprintf(f, "%s%s%s\n", d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz" : "x,y,mean_stress,eps_p,ux,uy",
           region ? ",region" : "", pw ? ",pore_pressure" : "");
   for (int k = 0; k < np; ++k) {
     const size_t q = (size_t)order[k].q;
     const double p = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3.0;
+    const double *ref = xs ? xs + (size_t)ids[q] * d : x0 + q * d;
     for (int a = 0; a < d; ++a) fprintf(f, "%.7g,", x[q * d + a]);
     fprintf(f, "%.7g,%.7g", p, eps ? eps[q] : 0.0);
-    for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - x0[q * d + a]);
+    for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - ref[a]);
     if (region) fprintf(f, ",%d", (int)region[q]);
     if (pw) fprintf(f, ",%.7g", pw[q]);
     fputc('\n', f);
@@ -145,13 +164,12 @@ int wf_gnuplot_close(FILE *g, const char *outdir, const char *log, char *warn, s
 
 /** @brief Write final_state.csv and the PNG plots into outdir. */
 int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *warn, size_t len) {
-  const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
-  int hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
-  if (hx == vy) hx = vy == 0 ? 1 : 0;
+  int hx, vy;
+  wf_view_axes(sc, &hx, &vy);
   char path[WF_PATH + 32];
   int has_eps = 0;
   snprintf(path, sizeof path, "%s/final_state.csv", outdir);
-  if (write_state(sim, sc, path, hx, vy, &has_eps)) {
+  if (write_state(sim, sc, path, hx, vy, NULL, &has_eps)) {
     snprintf(warn, len, "cannot write %s", path);
     return 1;
   }
@@ -165,15 +183,7 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
   /* columns of final_state.csv: coordinates, mean stress, eps_p */
   const int cx = hx + 1, cy = vy + 1, cp = d + 1, ce = d + 2;
   wf_gnuplot_terminal(g, 1400, 700, 12);
-  /* the phreatic line over the grid's width, where the view is along x (a polyline table) */
-  const char *water = "";
-  if (sc->water.n && hx == 0) {
-    const wf_water *wt = &sc->water;
-    fprintf(g, "$water << EOD\n%.9g,%.9g\n", sc->lo[0], wt->xh[1]);
-    for (int k = 0; k < wt->n; ++k) fprintf(g, "%.9g,%.9g\n", wt->xh[2 * k], wt->xh[2 * k + 1]);
-    fprintf(g, "%.9g,%.9g\nEOD\n", sc->hi[0], wt->xh[2 * wt->n - 1]);
-    water = ", $water using 1:2 with lines lw 2 lc rgb '#1f78b4' title 'water table'";
-  }
+  const char *water = water_line(g, sc, hx);
   fprintf(g, "set size ratio -1\nset xlabel '%c [m]'\nset ylabel '%c [m]'\nset grid\n", ax[hx], ax[vy]);
   fprintf(g, "set output 'final_mean_stress.png'\n");
   fprintf(g, "set title '%s%s: mean stress p = tr(sigma)/3 [kPa] at t = %.3f s (tension > 0)' noenhanced\n", sc->name,
@@ -216,46 +226,10 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
  *        from xs (positions by point id at the trial's start), into path.  0, or -1.
  */
 int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const double *xs, const char *path) {
-  const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
-  int hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
-  if (hx == vy) hx = vy == 0 ? 1 : 0;
-  int np = 0;
-  double *x, *sig, *eps = NULL, *region = NULL, *pw = NULL;
-  const int *ids;
-  if (mpmc_sim_get_num_particles(sim, &np) || mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
-      mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL) || mpmc_sim_get_particle_ids(sim, &ids))
-    return -1;
-  int plastic = 0;
-  for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
-  if (plastic && mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
-  if (mpmc_sim_get_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
-  if ((!sc->water.n && !sc->water.has_plane) || mpmc_sim_get_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
-  const int d = sc->dim, dz = 3 - hx - vy;
-  depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
-  FILE *f = order ? fopen(path, "w") : NULL;
-  if (!f) {
-    free(order);
-    return -1;
-  }
-  for (int q = 0; q < np; ++q) {
-    order[q].q = q;
-    order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
-  }
-  if (d == 3) qsort(order, (size_t)np, sizeof *order, by_depth);
-  fprintf(f, "%s%s%s\n", d == 3 ? "x,y,z,mean_stress,eps_p,ux,uy,uz" : "x,y,mean_stress,eps_p,ux,uy",
-          region ? ",region" : "", pw ? ",pore_pressure" : "");
-  for (int k = 0; k < np; ++k) {
-    const size_t q = (size_t)order[k].q, id = (size_t)ids[q];
-    const double p = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3.0;
-    for (int a = 0; a < d; ++a) fprintf(f, "%.7g,", x[q * d + a]);
-    fprintf(f, "%.7g,%.7g", p, eps ? eps[q] : 0.0);
-    for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - xs[id * d + a]);
-    if (region) fprintf(f, ",%d", (int)region[q]);
-    if (pw) fprintf(f, ",%.7g", pw[q]);
-    fputc('\n', f);
-  }
-  free(order);
-  return fclose(f) ? -1 : 0;
+  int hx, vy;
+  wf_view_axes(sc, &hx, &vy);
+  int has_eps;
+  return write_state(sim, sc, path, hx, vy, xs, &has_eps);
 }
 
 /**
@@ -298,18 +272,10 @@ int wf_fos_plots(const wf_scene *sc, int stage, const wf_fos_result *res, const 
     double t = 0.0;
     for (int i = 0; i < res->ntrial; ++i)
       if (res->trial[i].factor == res->hi) t = res->trial[i].sim_time;
-    const int vy = sc->dim == 2 ? 1 : vertical_axis(sc);
-    int hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
-    if (hx == vy) hx = vy == 0 ? 1 : 0;
+    int hx, vy;
+    wf_view_axes(sc, &hx, &vy);
     const int d = sc->dim, cx = hx + 1, cy = vy + 1, ce = d + 2, cu = d + 3;
-    const char *ax = "xyz", *water = "";
-    if (sc->water.n && hx == 0) {
-      const wf_water *wt = &sc->water;
-      fprintf(g, "$water << EOD\n%.9g,%.9g\n", sc->lo[0], wt->xh[1]);
-      for (int k = 0; k < wt->n; ++k) fprintf(g, "%.9g,%.9g\n", wt->xh[2 * k], wt->xh[2 * k + 1]);
-      fprintf(g, "%.9g,%.9g\nEOD\n", sc->hi[0], wt->xh[2 * wt->n - 1]);
-      water = ", $water using 1:2 with lines lw 2 lc rgb '#1f78b4' title 'water table'";
-    }
+    const char *ax = "xyz", *water = water_line(g, sc, hx);
     char umag[96];
     if (d == 3)
       snprintf(umag, sizeof umag, "(sqrt($%d**2 + $%d**2 + $%d**2))", cu, cu + 1, cu + 2);

@@ -37,38 +37,6 @@ static void csv_name(const wf_scene *sc, const wf_snapplot *p, int j, char *buf,
   snprintf(buf, len, "snap_%s_t%g_%s.csv", sc->stages[p->stage].name, p->times[j], wf_color_names[p->color]);
 }
 
-/* The vertical axis: the largest gravity component of the stages that set gravity. */
-static int vertical_of(const wf_scene *sc) {
-  if (sc->dim == 2) return 1;
-  int v = 2;
-  for (int i = 0; i < sc->nstage; ++i) {
-    if (!sc->stages[i].has_gravity) continue;
-    double best = 0;
-    for (int a = 0; a < sc->dim; ++a)
-      if (fabs(sc->stages[i].gravity[a]) > best) {
-        best = fabs(sc->stages[i].gravity[a]);
-        v = a;
-      }
-  }
-  return v;
-}
-
-static void view_axes(const wf_scene *sc, int *hx, int *vy) {
-  *vy = vertical_of(sc);
-  *hx = sc->metrics.enabled[WF_METRIC_RUNOUT] ? sc->metrics.runout_axis : 0;
-  if (*hx == *vy) *hx = *vy == 0 ? 1 : 0;
-}
-
-typedef struct {
-  double depth;
-  int q;
-} far_first;
-
-static int by_far(const void *a, const void *b) {
-  const double da = ((const far_first *)a)->depth, db = ((const far_first *)b)->depth;
-  return da < db ? 1 : da > db ? -1 : 0;
-}
-
 static int write_csv_fields(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, const char *path, double t) {
   int np, e;
   double *x, *x0, *v, *sig, *eps = NULL;
@@ -81,9 +49,9 @@ static int write_csv_fields(mpmc_sim sim, const wf_scene *sc, const wf_snapplot 
   if (p->color == WF_COLOR_EPS_P && (e = mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL))) return e;
   const int d = sc->dim;
   int hx, vy;
-  view_axes(sc, &hx, &vy);
+  wf_view_axes(sc, &hx, &vy);
   const int dz = 3 - hx - vy;
-  far_first *order = malloc(sizeof *order * (size_t)(np + 1));
+  wf_depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
   FILE *f = order ? fopen(path, "w") : NULL;
   if (!f) {
     free(order);
@@ -93,7 +61,7 @@ static int write_csv_fields(mpmc_sim sim, const wf_scene *sc, const wf_snapplot 
     order[q].q = q;
     order[q].depth = d == 3 ? x[(size_t)q * 3 + dz] : 0.0;
   }
-  if (d == 3) qsort(order, (size_t)np, sizeof *order, by_far);
+  if (d == 3) qsort(order, (size_t)np, sizeof *order, wf_by_depth);
   fprintf(f, "# %s at t = %.9g s of stage %s\n%c,%c,%s\n", wf_color_names[p->color], t, sc->stages[p->stage].name,
           "xyz"[hx], "xyz"[vy], wf_color_names[p->color]);
   for (int k = 0; k < np; ++k) {
@@ -172,7 +140,7 @@ int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t
   int missing = 0;
   fprintf(g, "set grid\n");
   int hx, vy;
-  view_axes(sc, &hx, &vy);
+  wf_view_axes(sc, &hx, &vy);
   for (int k = 0; k < sc->nsnapplot; ++k) {
     const wf_snapplot *p = &sc->snapplots[k];
     const char *stage = sc->stages[p->stage].name, *col = wf_color_names[p->color];

@@ -303,6 +303,13 @@ void wf_fos_json(FILE *f, const wf_fos_result *res);
 int wf_fos_read_csv(const char *path, wf_fos_result *res, char *msg, size_t len);
 /* factor_of_safety.jobs within [1, WF_FOS_MAX_JOBS] */
 int wf_fos_jobs(const wf_fos *f);
+/* plot.c: the plots' horizontal and vertical axes; points ordered far (large depth) first */
+void wf_view_axes(const wf_scene *sc, int *hx, int *vy);
+typedef struct {
+  double depth;
+  int q;
+} wf_depth_idx;
+int wf_by_depth(const void *a, const void *b);
 /* The state at a trial's end as a CSV in final_state.csv's columns, the displacement since
  * the trial's start (xs: positions by point id) (plot.c); 0, or -1. */
 int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const double *xs, const char *path);
