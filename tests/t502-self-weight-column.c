@@ -31,9 +31,7 @@ static result column_h(int basis, int fbar, int fixed_steps, double h) {
   mpmc_sim sim;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
-  TCALL(mpmc_sim_create(ctx, 2, &sim));
-  const double lo[2] = {0, 0}, hi[2] = {W, H + 2 * h};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  sim = test_column_sim(ctx, 2, W, H, 2 * h, h);
   TCALL(mpmc_sim_set_basis(sim, basis));
   TCALL(mpmc_sim_set_fbar(sim, fbar));
   const double gv[2] = {0, -g};
@@ -43,13 +41,8 @@ static result column_h(int basis, int fbar, int fixed_steps, double h) {
   TCALL(mpmc_sim_set_flip_blend(sim, 0.95));
   int mat;
   TCALL(mpmc_sim_add_material_hencky(sim, E, nu, rho, &mat));
-  double *x, *vol;
-  const double plo[2] = {0, 0}, phi[2] = {W, H};
-  const int n = test_lattice(2, plo, phi, h, 2, &x, &vol);
-  TCALL(mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  double *x;
+  const int n = test_column_fill(sim, 2, W, H, h, mat, &x);
   double dt;
   TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
   /* quasi-static: run until the kinetic energy is below 1e-10 of its peak (checked every
@@ -85,7 +78,6 @@ static result column_h(int basis, int fbar, int fixed_steps, double h) {
   }
   result r = {sqrt(se / n) / (rho * g * H), fabs(utop - uref) / uref, s};
   free(x);
-  free(vol);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;

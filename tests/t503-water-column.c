@@ -27,9 +27,7 @@ static void run(int fbar, double *rms_rel, double *vrms) {
   mpmc_sim sim;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
-  TCALL(mpmc_sim_create(ctx, 2, &sim));
-  const double lo[2] = {0, 0}, hi[2] = {W, H + 4 * h};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  sim = test_column_sim(ctx, 2, W, H, 4 * h, h);
   TCALL(mpmc_sim_set_fbar(sim, fbar));
   TCALL(mpmc_sim_set_flip_blend(sim, 0.95));
   /* 80 points: threads would only cost.  The step's stability check runs before the
@@ -39,13 +37,7 @@ static void run(int fbar, double *rms_rel, double *vrms) {
   TCALL(mpmc_sim_set_force_dt(sim, 1));
   int mat;
   TCALL(mpmc_sim_add_material_newtonian(sim, K, mu, rho, &mat));
-  double *x, *vol;
-  const double plo[2] = {0, 0}, phi[2] = {W, H};
-  const int n = test_lattice(2, plo, phi, h, 2, &x, &vol);
-  TCALL(mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  const int n = test_column_fill(sim, 2, W, H, h, mat, NULL);
   const double grav[2] = {0, -g};
   TCALL(mpmc_sim_set_gravity(sim, grav));
   TCALL(mpmc_sim_set_damping(sim, 0.1));
@@ -70,8 +62,7 @@ static void run(int fbar, double *rms_rel, double *vrms) {
     se += e * e;
   }
   *rms_rel = sqrt(se / n) / (rho * g * H);
-  free(x);
-  free(vol);
+
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;

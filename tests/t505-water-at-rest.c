@@ -30,25 +30,14 @@ static rest column(int dim, int basis, double K, int fbar) {
   mpmc_sim sim;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
-  TCALL(mpmc_sim_create(ctx, dim, &sim));
-  const double lo[3] = {0, 0, 0}, hi[3] = {W, dim == 2 ? H + 4 * h : W, H + 4 * h};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  sim = test_column_sim(ctx, dim, W, H, 4 * h, h);
   TCALL(mpmc_sim_set_basis(sim, basis));
   TCALL(mpmc_sim_set_fbar(sim, fbar));
   TCALL(mpmc_sim_set_flip_blend(sim, 0.95));
   TCALL(mpmc_sim_set_threads(sim, 1));
   int mat;
   TCALL(mpmc_sim_add_material_newtonian(sim, K, mu, rho, &mat));
-  double *x, *vol;
-  const double plo[3] = {0, 0, 0}, phi[3] = {W, dim == 2 ? H : W, H};
-  const int n = test_lattice(dim, plo, phi, h, 2, &x, &vol);
-  TCALL(mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
-  const int up = dim - 1; /* the vertical axis */
-  for (int a = 0; a < up; ++a) {
-    TCALL(mpmc_sim_add_wall_face(sim, 2 * a, MPMC_WALL_SLIP, NULL));
-    TCALL(mpmc_sim_add_wall_face(sim, 2 * a + 1, MPMC_WALL_SLIP, NULL));
-  }
-  TCALL(mpmc_sim_add_wall_face(sim, 2 * up, MPMC_WALL_FIXED, NULL));
+  const int n = test_column_fill(sim, dim, W, H, h, mat, NULL);
   const double grav[3] = {0, dim == 2 ? -g : 0, -g};
   TCALL(mpmc_sim_set_gravity(sim, grav));
   TCALL(mpmc_sim_set_damping(sim, 0.1));
@@ -72,11 +61,10 @@ static rest column(int dim, int basis, double K, int fbar) {
   double se = 0.0;
   for (int q = 0; q < n; ++q) {
     const double p = -(sg[6 * q] + sg[6 * q + 1] + sg[6 * q + 2]) / 3;
-    const double e = p - rho * g * (top - xp[(size_t)q * dim + up]);
+    const double e = p - rho * g * (top - xp[(size_t)q * dim + dim - 1]);
     se += e * e;
   }
-  free(x);
-  free(vol);
+
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;

@@ -31,9 +31,7 @@ static result column(double alpha, int kinetic, double adaptive, int restart, do
   mpmc_sim sim;
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
-  TCALL(mpmc_sim_create(ctx, 2, &sim));
-  const double lo[2] = {0, 0}, hi[2] = {W, H + 2 * h};
-  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  sim = test_column_sim(ctx, 2, W, H, 2 * h, h);
   TCALL(mpmc_sim_set_basis(sim, MPMC_BASIS_UGIMP));
   TCALL(mpmc_sim_set_fbar(sim, MPMC_FBAR_ANCHORED));
   const double gv[2] = {0, -g};
@@ -44,13 +42,8 @@ static result column(double alpha, int kinetic, double adaptive, int restart, do
   TCALL(mpmc_sim_set_flip_blend(sim, 0.99));
   int mat;
   TCALL(mpmc_sim_add_material_hencky(sim, E, nu, rho, &mat));
-  double *x, *vol;
-  const double plo[2] = {0, 0}, phi[2] = {W, H};
-  const int n = test_lattice(2, plo, phi, h, 2, &x, &vol);
-  TCALL(mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  TCALL(mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  double *x;
+  const int n = test_column_fill(sim, 2, W, H, h, mat, &x);
   double dt;
   TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
   double kemax = 0.0;
@@ -98,7 +91,6 @@ static result column(double alpha, int kinetic, double adaptive, int restart, do
   result r = {s, fabs(utop / ntop - uref) / uref, 0.0};
   TCALL(mpmc_sim_get_adaptive_damping(sim, &r.c));
   free(x);
-  free(vol);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;

@@ -78,6 +78,40 @@ static inline int test_lattice(int dim, const double *lo, const double *hi, doub
   return n;
 }
 
+/* ---- columns (t502, t503, t505, t506, t507) ----------------------------------------- */
+
+/* A column's sim in dim = 2 or 3: the grid over [0, W]^(dim-1) x [0, H + head] (the last
+ * axis vertical), cells of h. */
+static inline mpmc_sim test_column_sim(mpmc_context ctx, int dim, double W, double H, double head, double h) {
+  mpmc_sim sim;
+  TCALL(mpmc_sim_create(ctx, dim, &sim));
+  const double lo[3] = {0, 0, 0}, hi[3] = {W, dim == 2 ? H + head : W, H + head};
+  TCALL(mpmc_sim_set_grid(sim, lo, hi, h));
+  return sim;
+}
+
+/* The column [0, W]^(dim-1) x [0, H] of material mat, 2 points per cell and axis, its sides
+ * slip walls and its base fixed.  Returns the number of points; their positions in *x
+ * (malloc'ed; x NULL: freed). */
+static inline int test_column_fill(mpmc_sim sim, int dim, double W, double H, double h, int mat, double **x) {
+  double *xs, *vol;
+  const double plo[3] = {0, 0, 0}, phi[3] = {W, dim == 2 ? H : W, H};
+  const int n = test_lattice(dim, plo, phi, h, 2, &xs, &vol);
+  TCALL(mpmc_sim_add_particles(sim, n, xs, vol, mat, NULL));
+  const int up = dim - 1;
+  for (int a = 0; a < up; ++a) {
+    TCALL(mpmc_sim_add_wall_face(sim, 2 * a, MPMC_WALL_SLIP, NULL));
+    TCALL(mpmc_sim_add_wall_face(sim, 2 * a + 1, MPMC_WALL_SLIP, NULL));
+  }
+  TCALL(mpmc_sim_add_wall_face(sim, 2 * up, MPMC_WALL_FIXED, NULL));
+  free(vol);
+  if (x)
+    *x = xs;
+  else
+    free(xs);
+  return n;
+}
+
 /* ---- files ------------------------------------------------------------------------- */
 
 /* Whether path exists (file or directory). */
