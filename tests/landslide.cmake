@@ -9,10 +9,5 @@ endif()
 set(_ls_scene ${PROJECT_SOURCE_DIR}/workflows/slope_3d_reduced.yaml)
 set(_ls_expected ${PROJECT_SOURCE_DIR}/workflows/slope_3d_reduced_standard.expected.yaml)
 if(EXISTS ${_ls_scene} AND EXISTS ${_ls_expected})
-  add_test(NAME scene-slope_3d_reduced-standard
-    COMMAND mpmc_scene_check ${_ls_scene} ${_ls_expected}
-            ${CMAKE_CURRENT_BINARY_DIR}/scene-out/slope_3d_reduced_standard)
-  # one thread: ctest -j2 already fills two cores
-  set_tests_properties(scene-slope_3d_reduced-standard PROPERTIES LABELS workflow
-    ENVIRONMENT "OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
+  mpmc_scene_test(scene-slope_3d_reduced-standard ${_ls_scene} ${_ls_expected} slope_3d_reduced_standard)
 endif()

@@ -14,11 +14,7 @@ foreach(scene ${MPMC_SCENES})
     message(WARNING "workflows/${sname}.yaml has no ${sname}.expected.yaml: no CTest")
     continue()
   endif()
-  add_test(NAME scene-${sname}
-    COMMAND mpmc_scene_check ${scene} ${expected} ${CMAKE_CURRENT_BINARY_DIR}/scene-out/${sname})
-  # one thread each: ctest -j2 already fills two cores
-  set_tests_properties(scene-${sname} PROPERTIES LABELS workflow
-    ENVIRONMENT "OMP_NUM_THREADS=1;OPENBLAS_NUM_THREADS=1")
+  mpmc_scene_test(scene-${sname} ${scene} ${expected} ${sname})
 endforeach()
 foreach(t IN ITEMS t650-workflow-scene-errors t651-workflow-run t652-workflow-rigid t660-workflow-resume)
   if(TARGET ${t})
