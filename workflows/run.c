@@ -48,7 +48,6 @@ static int last_code(mpmc_context ctx) {
   return code;
 }
 
-typedef wf_clock stage_clock;
 
 typedef struct {
   mpmc_context ctx;
@@ -470,9 +469,9 @@ static int snapshot(wf_run *w) {
 
 #ifdef MPMC_WF_HAVE_CHECKPOINT
 /* At the start of `stage` (c == NULL: before its setup) or inside it (c: where it stands). */
-static int checkpoint(wf_run *w, int stage, const stage_clock *c, long steps) {
+static int checkpoint(wf_run *w, int stage, const wf_clock *c, long steps) {
   char path[WF_PATH], meta[16384];
-  const stage_clock c0 = {0};
+  const wf_clock c0 = {0};
   const int setup_done = c != NULL;
   if (!c) c = &c0;
   out_path(w, "checkpoint.h5", path, sizeof path);
@@ -530,7 +529,7 @@ static int wf_quasi_static(double ratio, double tol, double t_stage, double min_
 }
 
 /* Run stage i, from its start (from == NULL) or from where a checkpoint left it. */
-static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf_progress *pr) {
+static int run_stage(wf_run *w, int i, const wf_clock *from, long *nsteps, wf_progress *pr) {
   long steps = *nsteps;
   const wf_scene *sc = &w->sc;
   const wf_stage *s = &sc->stages[i];
@@ -539,7 +538,7 @@ static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf
   snprintf(rec->name, sizeof rec->name, "%s", s->name);
   const double T = s->end_time; /* quasi-static: the maximum time */
   const double w0 = wf_now();
-  stage_clock c = {.dt = s->dt, .ratio = 1.0};
+  wf_clock c = {.dt = s->dt, .ratio = 1.0};
   if (from && from->t_stage > 0) c = *from;
   double t_stage = c.t_stage, dt = s->dt > 0 ? s->dt : c.dt, ke = c.ke, ke_max = c.ke_max, ratio = c.ratio;
   double last_ckpt = w0, t0;
@@ -609,7 +608,7 @@ static int run_stage(wf_run *w, int i, const stage_clock *from, long *nsteps, wf
     if (!w->quiet) wf_progress_update(pr, sc, i, t_stage, T, steps, rate, sc->progress_interval, reason != NULL);
 #ifdef MPMC_WF_HAVE_CHECKPOINT
     if (!reason && now - last_ckpt > sc->checkpoint_interval) {
-      const stage_clock here = {t_stage, dt, ke, ke_max, ratio, next_series, next_snap};
+      const wf_clock here = {t_stage, dt, ke, ke_max, ratio, next_series, next_snap};
       if (checkpoint(w, i, &here, steps)) return -1;
       last_ckpt = now;
     }
@@ -686,7 +685,7 @@ static int open_outputs(wf_run *w, int append) {
 /* From the start of first_stage (from == NULL), or inside it: from->t_stage > 0, or at its
  * start once set up (setup_done: a checkpoint inside the stage, or the last stage of a
  * finished run going on to a later end) */
-static int run_all(wf_run *w, int first_stage, const stage_clock *from, long steps, int setup_done) {
+static int run_all(wf_run *w, int first_stage, const wf_clock *from, long steps, int setup_done) {
   const double t_stage = from ? from->t_stage : 0.0;
   wf_progress pr;
   wf_progress_init(&pr);
@@ -859,7 +858,10 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   int bad = wf_record_parse(meta, &rec, why, sizeof why) != 0;
   mpmc_free(meta);
   for (int i = 0; i < noverride && !bad; ++i) /* the caller's, after the run's own */
-    bad = wf_record_add_set(&rec, overrides[i]) != 0;
+    if (wf_record_add_set(&rec, overrides[i])) {
+      snprintf(why, sizeof why, "out of memory for the overrides");
+      bad = 1;
+    }
   int err = 0;
   wf_run w = {0};
   w.ctx = ctx;
@@ -869,7 +871,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   w.overrides = (const char *const *)rec.sets;
   /* the walls the checkpoint records: those of its stages, or of more (not yet added) */
   int walls_before = 0; /* of the stages up to the one resumed */
-  if (bad || rec.stage < 0 || !rec.scene[0]) {
+  if (bad) { /* wf_record_parse: a scene and a stage, or why not */
     err = WF_ERROR(ctx, MPMC_ERR_FORMAT, "resume: %s was not written by the workflow (%s)", path, why);
   } else if (prepare(&w, rec.scene, rec.nset, w.overrides)) {
     err = last_code(ctx);
@@ -890,7 +892,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     if (strcmp(r->reason, "quasi_static") != 0 && last->end_time > r->sim_time * (1 + 1e-9)) {
       /* the last stage again, at its old end, set up; ke_max is used by quasi-static ends
        * only, the step size is computed on the first step */
-      rec.clock = (stage_clock){.t_stage = r->sim_time, .ratio = 1.0};
+      rec.clock = (wf_clock){.t_stage = r->sim_time, .ratio = 1.0};
       --rec.stage;
       --rec.ndone;
       rec.setup = 1;
