@@ -17,7 +17,7 @@
 !> libraries (mpmc_seed_gmsh in libmpmc_gmsh) take a C string: pass mpmc_c_str('...').
 module mpmc
   use, intrinsic :: iso_c_binding, only: c_int, c_int64_t, c_double, c_char, c_ptr, c_funptr, &
-    c_null_ptr, c_null_char, c_size_t, c_associated, c_f_pointer, c_loc
+    c_long, c_null_ptr, c_null_char, c_size_t, c_associated, c_f_pointer, c_loc
   implicit none
   private
 
@@ -168,7 +168,7 @@ module mpmc
     mpmc_sim_set_water_table_plane, mpmc_sim_set_geostatic_stress
   ! MPI builds only (libmpmc/include/mpmc_mpi.h): comm is MPI's Fortran handle, the integer
   ! of the mpi module or mpi_f08's comm%MPI_VAL
-  public :: mpmc_sim_create_mpi_f, mpmc_sim_get_mpi_slab
+  public :: mpmc_sim_create_mpi_f, mpmc_sim_get_mpi_slab, mpmc_sim_get_mpi_traffic
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
@@ -315,6 +315,14 @@ module mpmc
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
       integer(c_int), intent(out) :: rank, nranks, axis, cell_lo, cell_hi
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_mpi_traffic(sim, halo_bytes, halo_msgs, migrated_bytes, &
+        migrate_msgs) bind(C, name='mpmc_sim_get_mpi_traffic') result(ierr)
+      import :: c_int, c_long, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), intent(out) :: halo_bytes, migrated_bytes
+      integer(c_long), intent(out) :: halo_msgs, migrate_msgs
       integer(c_int) :: ierr
     end function
     function mpmc_sim_get_dim(sim, dim) bind(C, name='mpmc_sim_get_dim') result(ierr)

@@ -27,6 +27,12 @@ int mpmc_sim_create_mpi_f(mpmc_context ctx, MPI_Fint comm, int dim, mpmc_sim *si
  * below the box); the simulation's grid must be set.  Any argument may be NULL. */
 int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis, int *cell_lo,
                           int *cell_hi);
+/* What this rank sent since the simulation was created: the bytes (payload) and messages of
+ * the halo sums (after P2G, and F-bar's after G2P), and of migration (points moving to
+ * another rank's slab, their counts included).  A message to a neighbour counts even when
+ * empty; ranks at the ends send to one neighbour.  Any argument may be NULL. */
+int mpmc_sim_get_mpi_traffic(const mpmc_sim sim, double *halo_bytes, long *halo_msgs,
+                             double *migrated_bytes, long *migrate_msgs);
 
 #ifdef __cplusplus
 }

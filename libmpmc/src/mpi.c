@@ -67,6 +67,10 @@ struct mpmc_dd_s {
   size_t cap;         /* doubles in each of the four                                      */
   double *gather;     /* [size * n] mpmc_dd_sum's                                         */
   int cap_gather;
+  /* what this rank sent since creation (mpmc_sim_get_mpi_traffic): bytes and messages of
+   * the halo sums, and of migration (its counts and records; rebalancing's included) */
+  double halo_bytes, migrate_bytes;
+  long halo_msgs, migrate_msgs;
 };
 
 enum { TAG_HALO = 4701, TAG_MIGRATE_N = 4702, TAG_MIGRATE = 4703 };
@@ -128,6 +132,26 @@ int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis,
   if (cell_lo) *cell_lo = dd->cut[dd->rank];
   if (cell_hi) *cell_hi = dd->cut[dd->rank + 1];
   return MPMC_SUCCESS;
+}
+
+/** @brief Bytes and messages this rank sent since creation (mpmc_mpi.h); NULL: skipped. */
+int mpmc_sim_get_mpi_traffic(const mpmc_sim sim, double *halo_bytes, long *halo_msgs,
+                             double *migrated_bytes, long *migrate_msgs) {
+  if (!sim) return MPMC_ERR_ARG;
+  const struct mpmc_dd_s *dd = sim->dd;
+  MPMC_CHECK(dd, sim->ctx, MPMC_ERR_STATE, "not a simulation of mpmc_sim_create_mpi");
+  if (halo_bytes) *halo_bytes = dd->halo_bytes;
+  if (halo_msgs) *halo_msgs = dd->halo_msgs;
+  if (migrated_bytes) *migrated_bytes = dd->migrate_bytes;
+  if (migrate_msgs) *migrate_msgs = dd->migrate_msgs;
+  return MPMC_SUCCESS;
+}
+
+/* Count a message of n elements of size bytes each to neighbour to (none: MPI_PROC_NULL). */
+static void count_sent(double *bytes, long *msgs, int to, size_t n, size_t size) {
+  if (to == MPI_PROC_NULL) return;
+  *bytes += (double)n * (double)size;
+  ++*msgs;
 }
 
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return sim->dd ? sim->dd->size : 1; }
@@ -432,6 +456,8 @@ int mpmc_dd_halo(struct mpmc_sim_s *sim, int what) {
   MPI_Irecv(ru, (int)each, MPI_DOUBLE, upper(dd), TAG_HALO, dd->comm, &req[1]);
   MPI_Isend(sl, (int)nl, MPI_DOUBLE, lower(dd), TAG_HALO, dd->comm, &req[2]);
   MPI_Isend(su, (int)nu, MPI_DOUBLE, upper(dd), TAG_HALO, dd->comm, &req[3]);
+  count_sent(&dd->halo_bytes, &dd->halo_msgs, lower(dd), nl, sizeof(double));
+  count_sent(&dd->halo_bytes, &dd->halo_msgs, upper(dd), nu, sizeof(double));
   MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
   /* the sends are done before the adds change arr; the two halos share no node */
   if (dd->rank > 0) unpack_add(g, arr, width, rl);
@@ -540,6 +566,8 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
   MPI_Irecv(hr[1], 3, MPI_INT, upper(dd), TAG_MIGRATE_N, dd->comm, &req[1]);
   MPI_Isend(hs[0], 3, MPI_INT, lower(dd), TAG_MIGRATE_N, dd->comm, &req[2]);
   MPI_Isend(hs[1], 3, MPI_INT, upper(dd), TAG_MIGRATE_N, dd->comm, &req[3]);
+  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, lower(dd), 3, sizeof(int));
+  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, upper(dd), 3, sizeof(int));
   MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
   size_t rlen[2];
   for (int s = 0; s < 2; ++s) {
@@ -589,6 +617,8 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
   MPI_Irecv(in[1], (int)rlen[1], MPI_DOUBLE, upper(dd), TAG_MIGRATE, dd->comm, &req[1]);
   MPI_Isend(out[0], (int)slen[0], MPI_DOUBLE, lower(dd), TAG_MIGRATE, dd->comm, &req[2]);
   MPI_Isend(out[1], (int)slen[1], MPI_DOUBLE, upper(dd), TAG_MIGRATE, dd->comm, &req[3]);
+  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, lower(dd), slen[0], sizeof(double));
+  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, upper(dd), slen[1], sizeof(double));
   MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
 
   /* the staying points close ranks, in order; sets renumbered */
