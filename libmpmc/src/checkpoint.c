@@ -9,7 +9,14 @@
  * mpmc_sim_set_material_user_fn) and scratch arrays (dF, xn, xoff, xnode, grid arrays) that
  * every step recomputes.  Rigid bodies (contact.h) are saved with their motion, last reaction and
  * friction anchors.  A checksum over everything else (root attribute checksum_fnv1a64) is
- * verified once every block has read. */
+ * verified once every block has read.
+ *
+ * Over MPI (io_mpi.h) the ranks write the one file collectively: the global blocks alike on
+ * every rank, the points as one hyperslab a rank, rank after rank, each in its storage order
+ * (a restart on as many ranks gives each its points in the same order: the same bits); the
+ * sets' members as those points' rows.  Rank 0 then adds the checksum and renames the file.
+ * A restart on any number of ranks reads the file on every rank and keeps the points of the
+ * rank's slab, with their ids and every field. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -18,7 +25,7 @@
 #include <unistd.h>
 
 #include "contact.h"
-#include "io.h"
+#include "io_mpi.h"
 #include "sets.h"
 
 #define CKPT_FORMAT "libmpmc-checkpoint"
@@ -50,6 +57,95 @@ static herr_t read_dataset(hid_t loc, const char *name, hid_t memtype, size_t ro
 
 static int exists(hid_t loc, const char *name) { return H5Lexists(loc, name, H5P_DEFAULT) > 0; }
 
+/* Dataset rows of `name` in g ([rows][cols]); -1 if absent or of another width. */
+static long dataset_rows(hid_t g, const char *name, hsize_t cols) {
+  hid_t ds = exists(g, name) ? H5Dopen2(g, name, H5P_DEFAULT) : -1;
+  if (ds < 0) return -1;
+  hid_t sp = H5Dget_space(ds);
+  hsize_t dims[2] = {0, 0};
+  const int rank = sp >= 0 ? H5Sget_simple_extent_dims(sp, dims, NULL) : -1;
+  if (sp >= 0) H5Sclose(sp);
+  H5Dclose(ds);
+  return rank == 2 && dims[1] == cols && dims[0] < 1000000 ? (long)dims[0] : -1;
+}
+
+/* The points a reading rank keeps: over MPI (more than one rank) the file rows of its slab's
+ * points, ascending; rows NULL: every row (one process). */
+typedef struct {
+  int *rows;
+  int n;           /* rows kept                                  */
+  long long total; /* the file's points                          */
+} ckpt_rows;
+
+enum { CKPT_CHUNK = 65536 }; /* rows read at a time when keeping some */
+
+/* Rows [r0, r0 + n) of dataset ds ([*][cols], cols 0: 1-D) into buf. */
+static herr_t read_slab(hid_t ds, hid_t memtype, hsize_t r0, hsize_t n, size_t cols, void *buf) {
+  const hsize_t start[2] = {r0, 0}, count[2] = {n, (hsize_t)cols};
+  hid_t fs = H5Dget_space(ds), ms = H5Screate_simple(cols ? 2 : 1, count, NULL);
+  herr_t st = fs < 0 || ms < 0 ? -1 : H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+  if (st >= 0) st = H5Dread(ds, memtype, ms, fs, H5P_DEFAULT, buf);
+  if (ms >= 0) H5Sclose(ms);
+  if (fs >= 0) H5Sclose(fs);
+  return st;
+}
+
+/* The rows k keeps of dataset `name` [k->total][cols] into out, one after another. */
+static herr_t read_kept(hid_t loc, const char *name, hid_t memtype, size_t cols, const ckpt_rows *k,
+                        void *out) {
+  if (!k->rows) return read_dataset(loc, name, memtype, (size_t)k->total, cols, out);
+  if (H5Lexists(loc, name, H5P_DEFAULT) <= 0) return -1;
+  hid_t ds = H5Dopen2(loc, name, H5P_DEFAULT);
+  if (ds < 0) return -1;
+  hid_t sp = H5Dget_space(ds);
+  hsize_t dims[2] = {0, 0};
+  const int rank = sp < 0 ? -1 : H5Sget_simple_extent_dims(sp, dims, NULL);
+  if (sp >= 0) H5Sclose(sp);
+  const size_t w = (cols ? cols : 1) * H5Tget_size(memtype);
+  char *tmp = rank == (cols ? 2 : 1) && dims[0] == (hsize_t)k->total && (!cols || dims[1] == cols)
+                  ? malloc(w * CKPT_CHUNK)
+                  : NULL;
+  herr_t st = tmp ? 0 : -1;
+  for (int i = 0; i < k->n && st >= 0;) {
+    const long long r0 = k->rows[i], r1 = r0 + CKPT_CHUNK < k->total ? r0 + CKPT_CHUNK : k->total;
+    st = read_slab(ds, memtype, (hsize_t)r0, (hsize_t)(r1 - r0), cols, tmp);
+    for (; st >= 0 && i < k->n && k->rows[i] < r1; ++i)
+      memcpy((char *)out + (size_t)i * w, tmp + (size_t)(k->rows[i] - r0) * w, w);
+  }
+  free(tmp);
+  H5Dclose(ds);
+  return st;
+}
+
+/* Over MPI: the rows of /particles/x [k->total][dim] that lie in this rank's slab. */
+static int select_rows(hid_t g, mpmc_sim sim, ckpt_rows *k) {
+  const int d = sim->dim;
+  hid_t ds = exists(g, "x") ? H5Dopen2(g, "x", H5P_DEFAULT) : -1;
+  double *x = malloc(sizeof(double) * CKPT_CHUNK * (size_t)d);
+  int cap = 0, err = ds >= 0 && x ? MPMC_SUCCESS
+                                  : MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT, "checkpoint /particles/x: unreadable");
+  for (long long r0 = 0; r0 < k->total && !err; r0 += CKPT_CHUNK) {
+    const long long n = k->total - r0 < CKPT_CHUNK ? k->total - r0 : CKPT_CHUNK;
+    if (read_slab(ds, H5T_NATIVE_DOUBLE, (hsize_t)r0, (hsize_t)n, (size_t)d, x) < 0) {
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT, "checkpoint /particles/x: not [%lld][%d]", k->total, d);
+      break;
+    }
+    for (long long i = 0; i < n && !err; ++i) {
+      if (!mpmc_dd_keep(sim, x + i * d)) continue; /* another rank's */
+      if (k->n == cap) {
+        cap = cap ? 2 * cap : 1024;
+        int *r = realloc(k->rows, sizeof(int) * (size_t)cap);
+        if (!r) err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "checkpoint: no memory for %d rows", cap);
+        else k->rows = r;
+      }
+      if (!err) k->rows[k->n++] = (int)(r0 + i);
+    }
+  }
+  free(x);
+  if (ds >= 0) H5Dclose(ds);
+  return err;
+}
+
 /* ---- block: configuration, grid, time, statistics ----------------------------------------- */
 
 static int write_config(hid_t f, const mpmc_sim sim) {
@@ -57,8 +153,17 @@ static int write_config(hid_t f, const mpmc_sim sim) {
   if (g < 0) return -1;
   const mpmc_grid *gr = &sim->grid;
   const int ints[] = {sim->dim, sim->basis, sim->fbar, sim->solver, sim->nthreads, sim->force_dt};
-  const int64_t stats[] = {sim->stats.steps, sim->stats.particle_steps, sim->stats.return_maps,
-                           sim->stats.kinsol_fallbacks};
+  /* over MPI every rank writes the same attributes: the counts summed over the ranks (exact
+   * in doubles below 2^53), the times the slowest rank's */
+  double counts[3] = {(double)sim->stats.particle_steps, (double)sim->stats.return_maps,
+                      (double)sim->stats.kinsol_fallbacks};
+  double secs[1 + MPMC_PHASE_COUNT];
+  secs[0] = sim->stats.wall_seconds;
+  memcpy(secs + 1, sim->stats.phase_seconds, sizeof sim->stats.phase_seconds);
+  mpmc_dd_sum(sim, counts, 3);
+  mpmc_dd_max(sim, secs, 1 + MPMC_PHASE_COUNT);
+  const int64_t stats[] = {sim->stats.steps, (int64_t)counts[0], (int64_t)counts[1],
+                           (int64_t)counts[2]};
   herr_t st = 0;
   st |= mpmc_h5_attr_write(g, "dim_basis_fbar_solver_nthreads_forcedt", H5T_NATIVE_INT, 6, ints);
   st |= mpmc_h5_attr_write(g, "flip", H5T_NATIVE_DOUBLE, 1, &sim->flip);
@@ -80,15 +185,25 @@ static int write_config(hid_t f, const mpmc_sim sim) {
   st |= mpmc_h5_attr_write(g, "grid_h", H5T_NATIVE_DOUBLE, 1, &gr->h);
   st |= mpmc_h5_attr_write(g, "stats_steps_particlesteps_returnmaps_kinsol", H5T_NATIVE_INT64, 4,
                            stats);
-  st |= mpmc_h5_attr_write(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1,
-                           &sim->stats.wall_seconds);
+  st |= mpmc_h5_attr_write(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1, secs);
   st |= mpmc_h5_attr_write(g, "stats_phase_seconds", H5T_NATIVE_DOUBLE, MPMC_PHASE_COUNT,
-                           sim->stats.phase_seconds);
-  const int64_t sort[2] = {sim->sort_every, sim->sort_last}; /* interval, step of the last */
-  st |= mpmc_h5_attr_write(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
+                           secs + 1);
+  int64_t sort[2] = {sim->sort_every, sim->sort_last}; /* interval, step of the last */
   /* the axis the last sort ordered by and the last slab build's: whether the next step sorts
    * because the slab axis changed (sort.c, mpmc_sort_due) */
-  const int axes[2] = {sim->sort_axis, sim->slab_axis};
+  int axes[2] = {sim->sort_axis, sim->slab_axis};
+  int rank, size;
+  mpmc_io_ranks(sim, &rank, &size);
+  if (size > 1) { /* each rank sorts its own points: every rank's, rank 0's as the attributes */
+    const int64_t mine[3] = {sim->sort_last, sim->sort_axis, sim->slab_axis};
+    hid_t dxpl = mpmc_io_dxpl(sim);
+    st |= mpmc_h5_rows_write(g, "rank_sort_last_sort_axis_slab_axis", H5T_STD_I64LE,
+                             H5T_NATIVE_INT64, size, 3, rank, 1, mine, dxpl);
+    mpmc_io_plist_close(dxpl);
+    mpmc_io_bcast(sim, sort, sizeof sort);
+    mpmc_io_bcast(sim, axes, sizeof axes);
+  }
+  st |= mpmc_h5_attr_write(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
   st |= mpmc_h5_attr_write(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
   const mpmc_water_table *wt = &sim->wt; /* kind, gamma_w, plane; the polyline's vertices */
   if (wt->kind != MPMC_WATER_NONE) {
@@ -159,8 +274,36 @@ static int read_adaptive_nodes(hid_t f, mpmc_sim sim) {
   return err;
 }
 
+/* A checkpoint written over MPI holds each rank's sort state: a restart on as many ranks
+ * takes its own row (on another number, rank 0's, in the attributes). */
+static int read_rank_sort(hid_t f, mpmc_sim sim) {
+  int rank, size;
+  mpmc_io_ranks(sim, &rank, &size);
+  hid_t g = H5Gopen2(f, "config", H5P_DEFAULT);
+  const char *name = "rank_sort_last_sort_axis_slab_axis";
+  const long rows = g >= 0 ? dataset_rows(g, name, 3) : -1;
+  int64_t mine[3];
+  herr_t st = 0;
+  if (rows == size && size > 1) {
+    hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
+    st = ds < 0 ? -1 : read_slab(ds, H5T_NATIVE_INT64, (hsize_t)rank, 1, 3, mine);
+    if (ds >= 0) H5Dclose(ds);
+  }
+  if (g >= 0) H5Gclose(g);
+  MPMC_CHECK(st >= 0, sim->ctx, MPMC_ERR_FORMAT, "checkpoint /config/%s: unreadable", name);
+  if (rows != size || size == 1) return MPMC_SUCCESS;
+  MPMC_CHECK(mine[0] >= -1 && mine[0] <= sim->stats.steps && mine[1] >= -1 && mine[1] < sim->dim &&
+                 mine[2] >= 0 && mine[2] < sim->dim,
+             sim->ctx, MPMC_ERR_FORMAT, "checkpoint /config/%s: bad row %d", name, rank);
+  sim->sort_last = mine[0];
+  sim->sort_axis = (int)mine[1];
+  sim->slab_axis = (int)mine[2];
+  return MPMC_SUCCESS;
+}
+
 /* The configuration goes through the public setters, which validate it. */
-static int read_config(hid_t f, mpmc_sim sim) {
+static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
+  (void)k;
   mpmc_context ctx = sim->ctx;
   hid_t g = exists(f, "config") ? H5Gopen2(f, "config", H5P_DEFAULT) : -1;
   MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /config group");
@@ -224,6 +367,10 @@ static int read_config(hid_t f, mpmc_sim sim) {
   sim->stats.particle_steps = stats[1];
   sim->stats.return_maps = stats[2];
   sim->stats.kinsol_fallbacks = stats[3];
+  int rank, size;
+  mpmc_io_ranks(sim, &rank, &size);
+  if (rank > 0) /* over MPI the file's counts are every rank's: rank 0 carries them on */
+    sim->stats.particle_steps = sim->stats.return_maps = sim->stats.kinsol_fallbacks = 0;
   sim->stats.wall_seconds = wall;
   for (int k = 0; k < MPMC_PHASE_COUNT; ++k) sim->stats.phase_seconds[k] = phase[k];
   MPMC_CHECK(sort[0] >= 0 && sort[0] <= INT32_MAX && sort[1] >= -1 && sort[1] <= stats[0], ctx,
@@ -235,7 +382,7 @@ static int read_config(hid_t f, mpmc_sim sim) {
              MPMC_ERR_FORMAT, "checkpoint /config: bad sort_axis_slab_axis = [%d, %d]", axes[0], axes[1]);
   sim->sort_axis = axes[0];
   sim->slab_axis = axes[1];
-  return MPMC_SUCCESS;
+  return read_rank_sort(f, sim);
 }
 
 /* ---- block: materials ------------------------------------------------------------------------ */
@@ -292,7 +439,8 @@ static double unattached_wave_speed(const mpmc_material *m) {
 static const mpmc_material_ops ops_unattached = {"user (unattached)", unattached_update,
                                                  unattached_wave_speed, 0, 0};
 
-static int read_materials(hid_t f, mpmc_sim sim) {
+static int read_materials(hid_t f, mpmc_sim sim, ckpt_rows *k) {
+  (void)k;
   mpmc_context ctx = sim->ctx;
   hid_t g = exists(f, "materials") ? H5Gopen2(f, "materials", H5P_DEFAULT) : -1;
   MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /materials group");
@@ -386,15 +534,17 @@ typedef struct {
   size_t off;
   int ncomp;
   int required;
+  int fill; /* over MPI, for a rank that has not allocated it: 0 zeros, 1 ones, 2 identity */
 } pfield;
-#define PF(f, nc, req) {#f, offsetof(mpmc_particles, f), nc, req}
-static const pfield pfields[] = {PF(x, 0, 1),     PF(x0, 0, 1),     PF(v, 0, 1),
-                                 PF(m, 1, 1),     PF(vol0, 1, 1),   PF(J, 1, 1),
-                                 PF(stress, 6, 1), PF(Jbar, 1, 0),  PF(be, 6, 0),
-                                 PF(eps_p, 1, 0), PF(lp, 1, 0),     PF(force, 0, 0),
-                                 PF(cforce, 0, 0), PF(ustate, -1, 0), PF(Janc, 1, 0),
-                                 PF(region, 1, 0), PF(Jp, 1, 0)};
+#define PF(f, nc, req, fill) {#f, offsetof(mpmc_particles, f), nc, req, fill}
+static const pfield pfields[] = {PF(x, 0, 1, 0),      PF(x0, 0, 1, 0),    PF(v, 0, 1, 0),
+                                 PF(m, 1, 1, 0),      PF(vol0, 1, 1, 0),  PF(J, 1, 1, 1),
+                                 PF(stress, 6, 1, 0), PF(Jbar, 1, 0, 1),  PF(be, 6, 0, 2),
+                                 PF(eps_p, 1, 0, 0),  PF(lp, 1, 0, 0),    PF(force, 0, 0, 0),
+                                 PF(cforce, 0, 0, 0), PF(ustate, -1, 0, 0), PF(Janc, 1, 0, 1),
+                                 PF(region, 1, 0, 0), PF(Jp, 1, 0, 1)};
 #undef PF
+#define NPFIELD (sizeof pfields / sizeof pfields[0])
 
 static double **pfield_ptr(mpmc_particles *p, const pfield *f) {
   return (double **)(void *)((char *)p + f->off);
@@ -403,46 +553,81 @@ static int pfield_ncomp(const mpmc_particles *p, const pfield *f) {
   return f->ncomp == 0 ? p->dim : f->ncomp < 0 ? p->nustate : f->ncomp;
 }
 
+/* Over MPI each rank writes its points as the rows from its offset, in its storage order;
+ * a field some rank has is written by all (the others' rows filled as the field starts). */
 static int write_particles(hid_t f, const mpmc_sim sim) {
   mpmc_particles *p = (mpmc_particles *)&sim->p;
+  long long off = 0, total = 0;
+  mpmc_io_scan(sim, p->n, &off, &total);
+  double nus = p->nustate;
+  mpmc_dd_max(sim, &nus, 1);
+  unsigned has = p->id ? 1u << NPFIELD : 0u; /* bit k: pfields[k] allocated; NPFIELD: ids */
+  for (size_t k = 0; k < NPFIELD; ++k)
+    if (*pfield_ptr(p, &pfields[k])) has |= 1u << k;
+  mpmc_io_or(sim, &has, 1);
+  const int n = p->n, ntot = (int)total, nustate = (int)nus;
   hid_t g = H5Gcreate2(f, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  if (g < 0) return -1;
-  herr_t st = 0;
-  st |= mpmc_h5_attr_write(g, "n", H5T_NATIVE_INT, 1, &p->n);
-  st |= mpmc_h5_attr_write(g, "nustate", H5T_NATIVE_INT, 1, &p->nustate);
-  for (size_t k = 0; k < sizeof pfields / sizeof pfields[0] && st >= 0; ++k) {
+  hid_t dxpl = mpmc_io_dxpl(sim);
+  double *fill = NULL;
+  herr_t st = g < 0 || dxpl < 0 ? -1 : 0;
+  if (st >= 0) {
+    st |= mpmc_h5_attr_write(g, "n", H5T_NATIVE_INT, 1, &ntot);
+    st |= mpmc_h5_attr_write(g, "nustate", H5T_NATIVE_INT, 1, &nustate);
+  }
+  for (size_t k = 0; k < NPFIELD && st >= 0; ++k) {
     const double *a = *pfield_ptr(p, &pfields[k]);
-    const int nc = pfield_ncomp(p, &pfields[k]);
-    if (!a || nc == 0) continue;
-    st |= mpmc_h5_dataset_write(g, pfields[k].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                                (size_t)p->n, nc > 1 ? (size_t)nc : 0, a);
+    const int nc = pfields[k].ncomp < 0 ? nustate : pfield_ncomp(p, &pfields[k]);
+    if (!(has >> k & 1u) || nc == 0) continue;
+    if (!a) { /* another rank's points have it */
+      free(fill);
+      fill = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1) * (size_t)nc);
+      if (!fill) st = -1;
+      for (size_t i = 0; fill && i < (size_t)n * (size_t)nc; ++i)
+        fill[i] = pfields[k].fill == 2 ? (i % 6 < 3) : pfields[k].fill;
+      a = fill;
+    }
+    if (st >= 0)
+      st |= mpmc_h5_rows_write(g, pfields[k].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, total,
+                               nc > 1 ? (size_t)nc : 0, off, (size_t)n, a, dxpl);
   }
   if (st >= 0)
-    st |= mpmc_h5_dataset_write(g, "mat", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)p->n, 0, p->mat);
-  if (st >= 0 && p->id) /* the points' ids once a sort has moved them (sort.c) */
-    st |= mpmc_h5_dataset_write(g, "id", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)p->n, 0, p->id);
-  H5Gclose(g);
+    st |= mpmc_h5_rows_write(g, "mat", H5T_STD_I32LE, H5T_NATIVE_INT, total, 0, off, (size_t)n,
+                             p->mat, dxpl);
+  if (st >= 0 && (has >> NPFIELD & 1u)) /* the points' ids once a sort moved them, or over MPI */
+    st |= mpmc_h5_rows_write(g, "id", H5T_STD_I32LE, H5T_NATIVE_INT, total, 0, off, (size_t)n,
+                             p->id, dxpl);
+  free(fill);
+  mpmc_io_plist_close(dxpl);
+  if (g >= 0) H5Gclose(g);
   return st < 0 ? -1 : 0;
 }
 
-static int read_particles(hid_t f, mpmc_sim sim) {
+/* Over MPI (k->rows) this rank's points are the rows of its slab. */
+static int read_particles(hid_t f, mpmc_sim sim, ckpt_rows *k) {
   mpmc_context ctx = sim->ctx;
   mpmc_particles *p = &sim->p;
   hid_t g = exists(f, "particles") ? H5Gopen2(f, "particles", H5P_DEFAULT) : -1;
   MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /particles group");
-  int n = -1, nus = -1;
+  int nt = -1, nus = -1;
   int err = MPMC_SUCCESS;
-  if (mpmc_h5_attr_read(g, "n", H5T_NATIVE_INT, 1, &n) < 0 || n < 0 ||
+  if (mpmc_h5_attr_read(g, "n", H5T_NATIVE_INT, 1, &nt) < 0 || nt < 0 ||
       mpmc_h5_attr_read(g, "nustate", H5T_NATIVE_INT, 1, &nus) < 0 || nus < 0)
-    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles: bad n = %d or nustate = %d", n,
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles: bad n = %d or nustate = %d", nt,
                      nus);
+  k->total = nt;
+  k->n = nt;
+  if (!err && mpmc_dd_ranks(sim) > 1) {
+    k->n = 0;
+    err = select_rows(g, sim, k);
+  }
+  const int n = k->n;
   if (!err) err = mpmc_particles_reserve(ctx, p, n > 64 ? n : 64);
   if (!err) {
     p->n = n;
     p->nustate = nus;
   }
-  for (size_t k = 0; k < sizeof pfields / sizeof pfields[0] && !err; ++k) {
-    const pfield *pf = &pfields[k];
+  for (size_t i = 0; i < NPFIELD && !err; ++i) {
+    const pfield *pf = &pfields[i];
     double **a = pfield_ptr(p, pf);
     const int nc = pfield_ncomp(p, pf);
     if (!exists(g, pf->name)) {
@@ -452,30 +637,33 @@ static int read_particles(hid_t f, mpmc_sim sim) {
       continue;
     }
     if (!*a) err = mpmc_particles_ensure(ctx, p, a, nc, 0.0);
-    if (!err && read_dataset(g, pf->name, H5T_NATIVE_DOUBLE, (size_t)n, nc > 1 ? (size_t)nc : 0,
-                             *a) < 0)
+    if (!err && read_kept(g, pf->name, H5T_NATIVE_DOUBLE, nc > 1 ? (size_t)nc : 0, k, *a) < 0)
       err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
                        "checkpoint /particles/%s: unreadable or not of shape [%d][%d]", pf->name,
-                       n, nc);
+                       nt, nc);
   }
-  if (!err && read_dataset(g, "mat", H5T_NATIVE_INT, (size_t)n, 0, p->mat) < 0)
-    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles/mat: missing or not [%d]", n);
+  if (!err && read_kept(g, "mat", H5T_NATIVE_INT, 0, k, p->mat) < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles/mat: missing or not [%d]", nt);
   for (int q = 0; q < n && !err; ++q)
     if (p->mat[q] < 0 || p->mat[q] >= sim->nmat)
       err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint point %d: material id %d of %d", q,
                        p->mat[q], sim->nmat);
-  if (!err && exists(g, "id")) {
+  sim->np_global = nt; /* the points added so far: the next one's id over MPI */
+  const int has_id = exists(g, "id");
+  if (!err && (has_id || sim->dd)) { /* over MPI the ids are global: a point keeps its row's */
     p->id = malloc(sizeof(int) * (size_t)p->cap);
-    if (!p->id || read_dataset(g, "id", H5T_NATIVE_INT, (size_t)n, 0, p->id) < 0)
-      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles/id: unreadable or not [%d]", n);
-    /* a permutation of 0 .. n-1: each id once */
-    unsigned char *seen = err ? NULL : calloc((size_t)n + 1, 1);
+    if (!p->id || (has_id && read_kept(g, "id", H5T_NATIVE_INT, 0, k, p->id) < 0))
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /particles/id: unreadable or not [%d]", nt);
+    for (int q = 0; q < n && !err && !has_id; ++q) p->id[q] = k->rows ? k->rows[q] : q;
+    p->global_ids = sim->dd != NULL;
+    /* a permutation of 0 .. nt-1: each id once (over MPI each rank checks its own) */
+    unsigned char *seen = err ? NULL : calloc((size_t)nt + 1, 1);
     if (!err && !seen) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "checkpoint: out of memory");
     for (int q = 0; q < n && !err; ++q) {
-      if (p->id[q] < 0 || p->id[q] >= n || seen[p->id[q]])
+      if (p->id[q] < 0 || p->id[q] >= nt || seen[p->id[q]])
         err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
                          "checkpoint /particles/id: point %d has id %d (not a permutation of 0 .. %d)",
-                         q, p->id[q], n - 1);
+                         q, p->id[q], nt - 1);
       else
         seen[p->id[q]] = 1;
     }
@@ -513,7 +701,8 @@ static int write_walls(hid_t f, const mpmc_sim sim) {
   return st < 0 ? -1 : 0;
 }
 
-static int read_walls(hid_t f, mpmc_sim sim) {
+static int read_walls(hid_t f, mpmc_sim sim, ckpt_rows *k) {
+  (void)k;
   mpmc_context ctx = sim->ctx;
   hid_t ds = exists(f, "walls") ? H5Dopen2(f, "walls", H5P_DEFAULT) : -1;
   MPMC_CHECK(ds >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /walls dataset");
@@ -560,31 +749,65 @@ static int read_walls(hid_t f, mpmc_sim sim) {
 
 /* One group per kind of set: a dataset per set ([n] point indices, or [n][dim] node
  * coordinates), named by number, with the set's name as an attribute. */
-static int write_set_group(hid_t f, const char *gname, const struct mpmc_sets_s *S, int ncomp) {
+/* Over MPI the particle sets' members are the rows of the points in /particles (each rank's
+ * from its offset), rank after rank; node sets are the same on every rank. */
+static int write_set_group(hid_t f, const mpmc_sim sim, const char *gname,
+                           const struct mpmc_sets_s *S, int ncomp) {
   hid_t g = H5Gcreate2(f, gname, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) return -1;
+  long long off = 0, total = 0, soff = 0, stotal = 0;
+  mpmc_io_scan(sim, sim->p.n, &off, &total);
+  hid_t dxpl = ncomp == 1 ? mpmc_io_dxpl(sim) : H5P_DEFAULT;
   const int ns = S ? S->n : 0;
-  herr_t st = mpmc_h5_attr_write(g, "count", H5T_NATIVE_INT, 1, &ns);
+  herr_t st = dxpl < 0 ? -1 : mpmc_h5_attr_write(g, "count", H5T_NATIVE_INT, 1, &ns);
   for (int k = 0; k < ns && st >= 0; ++k) {
     const mpmc_set *s = &S->s[k];
     char name[32];
     snprintf(name, sizeof name, "%06d", k); /* set names may hold '/' : kept as attributes */
-    st |= mpmc_h5_dataset_write(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)s->n,
-                                ncomp > 1 ? (size_t)ncomp : 0, s->idx);
+    if (ncomp == 1) {
+      int *rows = malloc(sizeof(int) * (size_t)(s->n > 0 ? s->n : 1));
+      for (int j = 0; rows && j < s->n; ++j) rows[j] = (int)off + s->idx[j];
+      mpmc_io_scan(sim, s->n, &soff, &stotal);
+      st |= rows ? mpmc_h5_rows_write(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, stotal, 0, soff,
+                                      (size_t)s->n, rows, dxpl)
+                 : -1;
+      free(rows);
+    } else {
+      st |= mpmc_h5_dataset_write(g, name, H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)s->n,
+                                  (size_t)ncomp, s->idx);
+    }
     hid_t ds = st >= 0 ? H5Dopen2(g, name, H5P_DEFAULT) : -1;
     if (ds < 0 || mpmc_h5_attr_write_string(ds, "name", s->name) < 0) st = -1;
     if (ds >= 0) H5Dclose(ds);
   }
+  mpmc_io_plist_close(dxpl);
   H5Gclose(g);
   return st < 0 ? -1 : 0;
 }
 
 static int write_sets(hid_t f, const mpmc_sim sim) {
-  if (write_set_group(f, "sets", sim->sets, 1) < 0) return -1;
-  return write_set_group(f, "node_sets", sim->node_sets, sim->dim);
+  if (write_set_group(f, sim, "sets", sim->sets, 1) < 0) return -1;
+  return write_set_group(f, sim, "node_sets", sim->node_sets, sim->dim);
 }
 
-static int read_set_group(hid_t f, mpmc_sim sim, const char *gname, int ncomp) {
+static int cmp_int(const void *a, const void *b) {
+  const int x = *(const int *)a, y = *(const int *)b;
+  return (x > y) - (x < y);
+}
+
+/* Over MPI (k->rows) the members among this rank's rows, as its indices. */
+static int local_members(const ckpt_rows *k, int *idx, int n) {
+  if (!k->rows) return n;
+  int m = 0;
+  for (int j = 0; j < n; ++j) {
+    const int *at = bsearch(&idx[j], k->rows, (size_t)k->n, sizeof(int), cmp_int);
+    if (at) idx[m++] = (int)(at - k->rows);
+  }
+  return m;
+}
+
+static int read_set_group(hid_t f, mpmc_sim sim, const char *gname, int ncomp,
+                          const ckpt_rows *kr) {
   mpmc_context ctx = sim->ctx;
   hid_t g = exists(f, gname) ? H5Gopen2(f, gname, H5P_DEFAULT) : -1;
   MPMC_CHECK(g >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint has no /%s group", gname);
@@ -609,7 +832,7 @@ static int read_set_group(hid_t f, mpmc_sim sim, const char *gname, int ncomp) {
     if (!idx || read_dataset(g, dname, H5T_NATIVE_INT, rows, ncomp > 1 ? (size_t)ncomp : 0, idx) < 0)
       err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /%s/%s: unreadable", gname, dname);
     else if (ncomp == 1)
-      err = mpmc_sim_add_particle_set(sim, name, (int)rows, idx, NULL);
+      err = mpmc_sim_add_particle_set(sim, name, local_members(kr, idx, (int)rows), idx, NULL);
     else
       err = mpmc_sim_add_node_set(sim, name, (int)rows, idx, NULL);
     free(idx);
@@ -619,10 +842,10 @@ static int read_set_group(hid_t f, mpmc_sim sim, const char *gname, int ncomp) {
   return err;
 }
 
-static int read_sets(hid_t f, mpmc_sim sim) {
-  MPMC_CALL(read_set_group(f, sim, "sets", 1));
+static int read_sets(hid_t f, mpmc_sim sim, ckpt_rows *k) {
+  MPMC_CALL(read_set_group(f, sim, "sets", 1, k));
   /* checkpoints written before node sets existed have none */
-  return exists(f, "node_sets") ? read_set_group(f, sim, "node_sets", sim->dim) : MPMC_SUCCESS;
+  return exists(f, "node_sets") ? read_set_group(f, sim, "node_sets", sim->dim, k) : MPMC_SUCCESS;
 }
 
 /* ---- block: rigid bodies (contact_barrier.c) ---------------------------------------------- */
@@ -632,6 +855,28 @@ static int read_sets(hid_t f, mpmc_sim sim) {
  * sim had a contact record at all (mpmc_sim_set_contact_params alone creates one), so that a
  * restart zeroes p->cforce on the same steps as the uninterrupted run. */
 #define BODYCOLS 19
+
+/* Body i's friction anchors over MPI: a row per point ([points][3]), each rank's from its
+ * offset in /particles; points beyond the anchors' count (added since the last contact
+ * pass) start at zero, as mpmc_contact_grow_anchors starts them. */
+static herr_t write_anchors_mpi(hid_t g, const mpmc_sim sim, int i) {
+  const mpmc_body *b = &sim->bodies->b[i];
+  const int n = sim->p.n;
+  long long off = 0, total = 0;
+  mpmc_io_scan(sim, n, &off, &total);
+  double *a = calloc(3 * (size_t)(n > 0 ? n : 1), sizeof(double));
+  hid_t dxpl = mpmc_io_dxpl(sim);
+  const int m = b->anchor ? (b->nanchor < n ? b->nanchor : n) : 0;
+  if (a && m) memcpy(a, b->anchor, sizeof(double) * 3 * (size_t)m);
+  char name[32];
+  snprintf(name, sizeof name, "anchor%d", i);
+  herr_t st = a && dxpl >= 0 ? mpmc_h5_rows_write(g, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, total,
+                                                  3, off, (size_t)n, a, dxpl)
+                             : -1;
+  mpmc_io_plist_close(dxpl);
+  free(a);
+  return st;
+}
 
 static int write_bodies(hid_t f, const mpmc_sim sim) {
   const struct mpmc_bodies_s *B = sim->bodies;
@@ -666,7 +911,14 @@ static int write_bodies(hid_t f, const mpmc_sim sim) {
     st |= mpmc_h5_attr_write_string(
         g, "bodies_columns", "active kind mu nvert lo[3] hi[3] v[3] offset[3] reaction[3]");
   }
-  for (int i = 0; i < nb && st >= 0; ++i) /* friction anchors (elastic stick) */
+  int rank, size;
+  mpmc_io_ranks(sim, &rank, &size);
+  for (int i = 0; i < nb && st >= 0 && size > 1; ++i) { /* over MPI: per point, as /particles */
+    unsigned has = B->b[i].anchor != NULL;
+    mpmc_io_or(sim, &has, 1);
+    if (has) st |= write_anchors_mpi(g, sim, i);
+  }
+  for (int i = 0; i < nb && st >= 0 && size == 1; ++i) /* friction anchors (elastic stick) */
     if (B->b[i].anchor) {
       char name[32];
       snprintf(name, sizeof name, "anchor%d", i);
@@ -679,20 +931,8 @@ static int write_bodies(hid_t f, const mpmc_sim sim) {
   return st < 0 ? -1 : 0;
 }
 
-/* Dataset rows of `name` in g ([rows][cols]); -1 if absent or of another width. */
-static long dataset_rows(hid_t g, const char *name, hsize_t cols) {
-  hid_t ds = exists(g, name) ? H5Dopen2(g, name, H5P_DEFAULT) : -1;
-  if (ds < 0) return -1;
-  hid_t sp = H5Dget_space(ds);
-  hsize_t dims[2] = {0, 0};
-  const int rank = sp >= 0 ? H5Sget_simple_extent_dims(sp, dims, NULL) : -1;
-  if (sp >= 0) H5Sclose(sp);
-  H5Dclose(ds);
-  return rank == 2 && dims[1] == cols && dims[0] < 1000000 ? (long)dims[0] : -1;
-}
-
 /* A checkpoint without the group (written before bodies were saved) has no bodies. */
-static int read_bodies(hid_t f, mpmc_sim sim) {
+static int read_bodies(hid_t f, mpmc_sim sim, ckpt_rows *kr) {
   mpmc_context ctx = sim->ctx;
   if (!exists(f, "bodies")) return MPMC_SUCCESS;
   hid_t g = H5Gopen2(f, "bodies", H5P_DEFAULT);
@@ -762,13 +1002,17 @@ static int read_bodies(hid_t f, mpmc_sim sim) {
       err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /bodies/%s is not [n][3]", aname);
       break;
     }
-    if (na > 0) {
-      b->anchor = malloc(sizeof(double) * 3 * (size_t)na);
-      if (!b->anchor || read_dataset(g, aname, H5T_NATIVE_DOUBLE, (size_t)na, 3, b->anchor) < 0) {
+    /* over MPI the rows of this rank's points below the anchors' count (a prefix of them) */
+    ckpt_rows sub = {kr->rows, 0, na};
+    while (kr->rows && sub.n < kr->n && kr->rows[sub.n] < na) sub.n++;
+    const long nk = kr->rows ? sub.n : na;
+    if (nk > 0) {
+      b->anchor = malloc(sizeof(double) * 3 * (size_t)nk);
+      if (!b->anchor || read_kept(g, aname, H5T_NATIVE_DOUBLE, 3, &sub, b->anchor) < 0) {
         err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint /bodies/%s: unreadable", aname);
         break;
       }
-      b->nanchor = (int)na;
+      b->nanchor = (int)nk;
     }
   }
   H5Gclose(g);
@@ -861,7 +1105,7 @@ static int checksum(hid_t f, uint64_t *h) {
 typedef struct {
   const char *name;
   int (*write)(hid_t f, const mpmc_sim sim); /* < 0 on an HDF5 failure             */
-  int (*read)(hid_t f, mpmc_sim sim);        /* an MPMC error code with a message  */
+  int (*read)(hid_t f, mpmc_sim sim, ckpt_rows *k); /* an MPMC error code with a message */
 } block;
 
 /* Materials before particles (ids are checked), particles before sets (indices are). */
@@ -883,10 +1127,12 @@ int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");
-  MPMC_CHECK(mpmc_dd_ranks(sim) == 1, ctx, MPMC_ERR_UNSUPPORTED,
-             "checkpoints of a run over %d MPI ranks are not supported yet (issue 47: one file "
-             "written collectively with parallel HDF5)", mpmc_dd_ranks(sim));
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "checkpoint: no grid set, nothing to save");
+  int rank, size;
+  mpmc_io_ranks(sim, &rank, &size);
+  MPMC_CHECK(size == 1 || !sim->adr, ctx, MPMC_ERR_UNSUPPORTED,
+             "checkpoint over %d MPI ranks: adaptive damping's estimate and node store are each "
+             "rank's own, not yet one state to save; turn it off or run on one rank", size);
   const size_t len = strlen(path) + 5;
   char *tmp = malloc(len);
   MPMC_CHECK(tmp, ctx, MPMC_ERR_MEMORY, "cannot allocate a path");
@@ -894,7 +1140,9 @@ int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *
   mpmc_h5_quiet q;
   mpmc_h5_quiet_begin(&q);
   int err = MPMC_SUCCESS;
-  hid_t f = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  hid_t fapl = mpmc_io_fapl(sim); /* over MPI: every rank writes the one file */
+  hid_t f = fapl < 0 ? -1 : H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+  mpmc_io_plist_close(fapl);
   if (f < 0) {
     err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot create the checkpoint file '%s'", tmp);
   } else {
@@ -909,25 +1157,34 @@ int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *
       if (blocks[b].write(f, sim) < 0)
         err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot write the '%s' block of '%s'", blocks[b].name,
                          tmp);
+    if (H5Fclose(f) < 0 && !err) err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot close '%s'", tmp);
+  }
+  err = mpmc_dd_agree(sim, err);
+  /* the checksum over the whole file, by one process (rank 0 over MPI, after every rank
+   * closed it), then the file made durable and renamed */
+  if (!err && rank == 0) {
+    f = H5Fopen(tmp, H5F_ACC_RDWR, H5P_DEFAULT);
     uint64_t sum = 0;
-    if (!err && (checksum(f, &sum) < 0 || mpmc_h5_attr_write(f, CKPT_CHECKSUM, H5T_STD_U64LE, 1, &sum) < 0))
+    if (f < 0 || checksum(f, &sum) < 0 || mpmc_h5_attr_write(f, CKPT_CHECKSUM, H5T_STD_U64LE, 1, &sum) < 0)
       err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot write the checksum of '%s'", tmp);
     if (!err && H5Fflush(f, H5F_SCOPE_GLOBAL) < 0)
       err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot flush '%s'", tmp);
-    if (H5Fclose(f) < 0 && !err) err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot close '%s'", tmp);
+    if (f >= 0 && H5Fclose(f) < 0 && !err) err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot close '%s'", tmp);
   }
   mpmc_h5_quiet_end(&q);
-  if (!err && mpmc_fsync_path(tmp) != 0)
-    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot fsync '%s': %s", tmp, strerror(errno));
-  if (!err && rename(tmp, path) != 0)
-    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot rename '%s' to '%s': %s", tmp, path,
-                     strerror(errno));
-  if (err)
-    remove(tmp);
-  else
-    mpmc_fsync_path(path); /* the directory entry of the rename */
+  if (rank == 0) {
+    if (!err && mpmc_fsync_path(tmp) != 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot fsync '%s': %s", tmp, strerror(errno));
+    if (!err && rename(tmp, path) != 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot rename '%s' to '%s': %s", tmp, path,
+                       strerror(errno));
+    if (err)
+      remove(tmp);
+    else
+      mpmc_fsync_path(path); /* the directory entry of the rename */
+  }
   free(tmp);
-  return err;
+  return mpmc_dd_agree(sim, err);
 }
 
 /* The file's checksum against its record.  Files written before the checksum have none:
@@ -946,9 +1203,10 @@ static int verify_checksum(mpmc_context ctx, const char *path, hid_t f) {
   return MPMC_SUCCESS;
 }
 
-static int read_file(mpmc_context ctx, const char *path, hid_t f, mpmc_sim *out, char **meta) {
+/* The file's format, version and dimension. */
+static int read_header(mpmc_context ctx, const char *path, hid_t f, int *dim) {
   char *fmt = NULL;
-  int version = -1, dim = 0;
+  int version = -1;
   if (mpmc_h5_attr_read_string(f, "format", &fmt) < 0 || strcmp(fmt, CKPT_FORMAT) != 0) {
     const int err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
                                "'%s' is an HDF5 file but not a libmpmc checkpoint (format '%s')",
@@ -964,20 +1222,41 @@ static int read_file(mpmc_context ctx, const char *path, hid_t f, mpmc_sim *out,
              version, MPMC_VERSION_STRING, CKPT_VERSION);
   hid_t g = exists(f, "config") ? H5Gopen2(f, "config", H5P_DEFAULT) : -1;
   int ints[6] = {0};
+  *dim = 0;
   if (g >= 0) {
     if (mpmc_h5_attr_read(g, "dim_basis_fbar_solver_nthreads_forcedt", H5T_NATIVE_INT, 6, ints) >= 0)
-      dim = ints[0];
+      *dim = ints[0];
     H5Gclose(g);
   }
-  MPMC_CHECK(dim == 2 || dim == 3, ctx, MPMC_ERR_FORMAT,
-             "checkpoint '%s': /config missing or dimension %d is not 2 or 3", path, dim);
+  MPMC_CHECK(*dim == 2 || *dim == 3, ctx, MPMC_ERR_FORMAT,
+             "checkpoint '%s': /config missing or dimension %d is not 2 or 3", path, *dim);
+  return MPMC_SUCCESS;
+}
+
+/* The simulation of the file, over comm (NULL: one process): every rank reads the file and
+ * keeps the points of its slab. */
+static int read_file(mpmc_context ctx, const void *comm, const char *path, hid_t f, int dim,
+                     mpmc_sim *out, char **meta) {
   mpmc_sim sim = NULL;
-  MPMC_CALL(mpmc_sim_create(ctx, dim, &sim));
-  int err = MPMC_SUCCESS;
-  for (size_t b = 0; b < NBLOCK && !err; ++b) err = blocks[b].read(f, sim);
+  MPMC_CALL(mpmc_io_sim_create(ctx, comm, dim, &sim));
+  ckpt_rows k = {NULL, 0, 0};
+  int err = MPMC_SUCCESS, rank, size;
+  mpmc_io_ranks(sim, &rank, &size);
+  for (size_t b = 0; b < NBLOCK && !err; ++b) err = blocks[b].read(f, sim, &k);
+  err = mpmc_dd_agree(sim, err);
   /* after the blocks: a block that does not make sense is named by its own message; a file
-   * whose every block reads is still refused when a bit of it changed */
-  if (!err) err = verify_checksum(ctx, path, f);
+   * whose every block reads is still refused when a bit of it changed (over MPI: rank 0
+   * reads it all once) */
+  if (!err && rank == 0) err = verify_checksum(ctx, path, f);
+  err = mpmc_dd_agree(sim, err);
+  if (!err && size > 1) { /* every point on one rank */
+    long long off, total;
+    mpmc_io_scan(sim, sim->p.n, &off, &total);
+    if (total != k.total)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint '%s': the ranks kept %lld of its %lld points",
+                       path, total, k.total);
+  }
+  free(k.rows);
   char *m = NULL;
   if (!err && meta && mpmc_h5_attr_read_string(f, "meta", &m) < 0)
     err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "checkpoint '%s' has no meta text", path);
@@ -993,8 +1272,33 @@ static int read_file(mpmc_context ctx, const char *path, hid_t f, mpmc_sim *out,
   return MPMC_SUCCESS;
 }
 
+static int read_path(mpmc_context ctx, const void *comm, const char *path, mpmc_sim *sim, char **meta) {
+  int err = MPMC_SUCCESS, dim = 0;
+  hid_t f = -1;
+  mpmc_h5_quiet q;
+  mpmc_h5_quiet_begin(&q);
+  if (access(path, R_OK) != 0) {
+    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot read checkpoint '%s': %s", path, strerror(errno));
+  } else {
+    const htri_t is = H5Fis_hdf5(path);
+    f = is > 0 ? H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT) : -1; /* over MPI: on every rank */
+    if (is <= 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "'%s' is not an HDF5 file (foreign or truncated)", path);
+    else if (f < 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "'%s' is a damaged HDF5 file (truncated?)", path);
+    else
+      err = read_header(ctx, path, f, &dim);
+  }
+  err = mpmc_io_agree(ctx, comm, err);
+  if (!err) err = read_file(ctx, comm, path, f, dim, sim, meta);
+  if (f >= 0) H5Fclose(f);
+  mpmc_h5_quiet_end(&q);
+  return err;
+}
+
 /**
- * @brief Create a simulation from a checkpoint written by mpmc_sim_checkpoint_write.
+ * @brief Create a simulation from a checkpoint written by mpmc_sim_checkpoint_write (by one
+ *        process or by any number of MPI ranks: the one process keeps every point).
  *        User materials come back without their function: re-attach it with
  *        mpmc_sim_set_material_user_fn before stepping.
  * @param[out] sim the new simulation (untouched on failure)
@@ -1006,23 +1310,31 @@ int mpmc_sim_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, 
   if (!ctx) return MPMC_ERR_ARG;
   MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");
   MPMC_CHECK(sim, ctx, MPMC_ERR_ARG, "sim pointer is NULL");
-  MPMC_CHECK(access(path, R_OK) == 0, ctx, MPMC_ERR_IO, "cannot read checkpoint '%s': %s", path,
-             strerror(errno));
-  mpmc_h5_quiet q;
-  mpmc_h5_quiet_begin(&q);
-  int err;
-  const htri_t is = H5Fis_hdf5(path);
-  hid_t f = is > 0 ? H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT) : -1;
-  if (is <= 0)
-    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "'%s' is not an HDF5 file (foreign or truncated)", path);
-  else if (f < 0)
-    err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT, "'%s' is a damaged HDF5 file (truncated?)", path);
-  else
-    err = read_file(ctx, path, f, sim, meta);
-  if (f >= 0) H5Fclose(f);
-  mpmc_h5_quiet_end(&q);
-  return err;
+  return read_path(ctx, NULL, path, sim, meta);
 }
+
+#ifdef MPMC_HAVE_MPI
+/**
+ * @brief mpmc_sim_checkpoint_read over the ranks of comm (collective), whatever the number
+ *        of ranks that wrote the file: each rank keeps the points of its slab, with their
+ *        ids and every field; the rest of the state is the same on every rank.
+ * @param comm an intra-communicator (duplicated, as by mpmc_sim_create_mpi)
+ */
+int mpmc_sim_checkpoint_read_mpi(mpmc_context ctx, MPI_Comm comm, const char *path, mpmc_sim *sim,
+                                 char **meta) {
+  if (!ctx) return MPMC_ERR_ARG;
+  MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");
+  MPMC_CHECK(sim, ctx, MPMC_ERR_ARG, "sim pointer is NULL");
+  MPMC_CHECK(comm != MPI_COMM_NULL, ctx, MPMC_ERR_ARG, "checkpoint read: comm is MPI_COMM_NULL");
+  return read_path(ctx, &comm, path, sim, meta);
+}
+
+/** @brief mpmc_sim_checkpoint_read_mpi for Fortran: comm is MPI's Fortran handle. */
+int mpmc_sim_checkpoint_read_mpi_f(mpmc_context ctx, MPI_Fint comm, const char *path, mpmc_sim *sim,
+                                   char **meta) {
+  return mpmc_sim_checkpoint_read_mpi(ctx, MPI_Comm_f2c(comm), path, sim, meta);
+}
+#endif
 
 /** @brief Release memory the library handed out (e.g. the meta text of a checkpoint). */
 void mpmc_free(void *ptr) { free(ptr); }

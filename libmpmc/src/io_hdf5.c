@@ -8,12 +8,13 @@
 #include <fcntl.h>
 #include <libgen.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "io.h"
+#include "io_mpi.h"
 #include "sets.h"
 
 void mpmc_h5_quiet_begin(mpmc_h5_quiet *q) {
@@ -97,6 +98,29 @@ herr_t mpmc_h5_dataset_write(hid_t loc, const char *name, hid_t filetype, hid_t 
   return st;
 }
 
+herr_t mpmc_h5_rows_write(hid_t loc, const char *name, hid_t filetype, hid_t memtype,
+                          long long total, size_t cols, long long offset, size_t n,
+                          const void *buf, hid_t dxpl) {
+  const hsize_t dims[2] = {(hsize_t)total, (hsize_t)cols};
+  const hsize_t start[2] = {(hsize_t)offset, 0}, count[2] = {(hsize_t)n, (hsize_t)cols};
+  hid_t space = H5Screate_simple(cols ? 2 : 1, dims, NULL);
+  hid_t mem = H5Screate_simple(cols ? 2 : 1, count, NULL);
+  hid_t ds = space < 0 || mem < 0 ? -1
+                                  : H5Dcreate2(loc, name, filetype, space, H5P_DEFAULT, H5P_DEFAULT,
+                                               H5P_DEFAULT);
+  herr_t st = ds < 0 ? -1 : 0;
+  if (st >= 0 && total > 0) { /* every rank takes part, one with no rows selects none */
+    st = n ? H5Sselect_hyperslab(space, H5S_SELECT_SET, start, NULL, count, NULL)
+           : H5Sselect_none(space);
+    if (st >= 0 && !n) st = H5Sselect_none(mem);
+    if (st >= 0) st = H5Dwrite(ds, memtype, mem, space, dxpl, buf);
+  }
+  if (ds >= 0) H5Dclose(ds);
+  if (mem >= 0) H5Sclose(mem);
+  if (space >= 0) H5Sclose(space);
+  return st;
+}
+
 int mpmc_fsync_path(const char *path) {
   int fd = open(path, O_RDONLY);
   if (fd < 0) return -1;
@@ -143,6 +167,13 @@ static char *h5_reference(const char *h5path, const char *xdmfpath) {
   return ref;
 }
 
+/* The XDMF file, by rank 0 over MPI (it names the one HDF5 file and every point). */
+static int write_xdmf(mpmc_output o) {
+  int rank, size;
+  mpmc_io_ranks(o->sim, &rank, &size);
+  return mpmc_dd_agree(o->sim, rank == 0 ? mpmc_xdmf_write(o) : MPMC_SUCCESS);
+}
+
 /**
  * @brief Start an output series: create (truncate) h5path and write an XDMF file xdmfpath
  *        that lists the snapshots (rewritten after each one).
@@ -154,9 +185,6 @@ int mpmc_output_create(mpmc_sim sim, const char *h5path, const char *xdmfpath, m
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(out, ctx, MPMC_ERR_ARG, "output handle pointer out is NULL");
-  MPMC_CHECK(mpmc_dd_ranks(sim) == 1, ctx, MPMC_ERR_UNSUPPORTED,
-             "snapshots of a run over %d MPI ranks are not supported yet (issue 47: one file "
-             "written collectively with parallel HDF5)", mpmc_dd_ranks(sim));
   MPMC_CHECK(h5path && h5path[0], ctx, MPMC_ERR_ARG, "HDF5 path h5path is NULL or empty");
   MPMC_CHECK(xdmfpath && xdmfpath[0], ctx, MPMC_ERR_ARG, "XDMF path xdmfpath is NULL or empty");
   MPMC_CHECK(strcmp(h5path, xdmfpath) != 0, ctx, MPMC_ERR_ARG,
@@ -164,7 +192,9 @@ int mpmc_output_create(mpmc_sim sim, const char *h5path, const char *xdmfpath, m
   *out = NULL;
   mpmc_h5_quiet q;
   mpmc_h5_quiet_begin(&q);
-  hid_t f = H5Fcreate(h5path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  hid_t fapl = mpmc_io_fapl(sim); /* over MPI: every rank creates the one file */
+  hid_t f = fapl < 0 ? -1 : H5Fcreate(h5path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+  mpmc_io_plist_close(fapl);
   herr_t st = f < 0 ? -1 : 0;
   if (f >= 0) {
     if (mpmc_h5_attr_write_string(f, "format", "libmpmc-output") < 0) st = -1;
@@ -172,18 +202,19 @@ int mpmc_output_create(mpmc_sim sim, const char *h5path, const char *xdmfpath, m
     if (H5Fclose(f) < 0) st = -1;
   }
   mpmc_h5_quiet_end(&q);
-  MPMC_CHECK(st >= 0, ctx, MPMC_ERR_IO, "cannot create the HDF5 output file '%s'", h5path);
-  mpmc_output o = calloc(1, sizeof *o);
-  MPMC_CHECK(o, ctx, MPMC_ERR_MEMORY, "cannot allocate an output handle");
-  o->sim = sim;
-  o->h5path = dup_str(h5path);
-  o->xdmfpath = dup_str(xdmfpath);
-  o->h5ref = h5_reference(h5path, xdmfpath);
-  if (!o->h5path || !o->xdmfpath || !o->h5ref) {
-    mpmc_output_destroy(&o);
-    return MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "cannot store the output paths ('%s')", h5path);
+  int err = st < 0 ? MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot create the HDF5 output file '%s'", h5path)
+                   : MPMC_SUCCESS;
+  mpmc_output o = err ? NULL : calloc(1, sizeof *o);
+  if (o) {
+    o->sim = sim;
+    o->h5path = dup_str(h5path);
+    o->xdmfpath = dup_str(xdmfpath);
+    o->h5ref = h5_reference(h5path, xdmfpath);
   }
-  const int err = mpmc_xdmf_write(o);
+  if (!err && (!o || !o->h5path || !o->xdmfpath || !o->h5ref))
+    err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "cannot store the output paths ('%s')", h5path);
+  err = mpmc_dd_agree(sim, err);
+  if (!err) err = write_xdmf(o);
   if (err) {
     mpmc_output_destroy(&o);
     return err;
@@ -204,16 +235,6 @@ static int note_field(mpmc_context ctx, mpmc_snap *s, const char *name, int ncom
   return MPMC_SUCCESS;
 }
 
-/* Write [n][ncomp] doubles, padding dim-component vectors to 3 so that ParaView shows points
- * and vectors in 2D (z = 0). */
-static herr_t write_padded(hid_t g, const char *name, const double *src, int n, int d, int ncomp,
-                           double *buf) {
-  for (size_t q = 0; q < (size_t)n; ++q)
-    for (int a = 0; a < ncomp; ++a) buf[q * (size_t)ncomp + a] = a < d ? src[q * (size_t)d + a] : 0.0;
-  return mpmc_h5_dataset_write(g, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)n,
-                               (size_t)(ncomp > 1 ? ncomp : 0), buf);
-}
-
 /* A set name as an HDF5 link name: '/' and a leading '.' are not allowed there. */
 static void set_dataset_name(char *dst, size_t len, const char *name) {
   snprintf(dst, len, "set_%s", name);
@@ -221,83 +242,195 @@ static void set_dataset_name(char *dst, size_t len, const char *name) {
     if (*c == '/') *c = '_';
 }
 
-static int write_snapshot(mpmc_output out, hid_t g, mpmc_snap *s, double *buf,
-                          unsigned char *mark) {
+/* A snapshot's points as records of doubles, one row a point, which go to the rank that
+ * writes them and are sorted by id there: column 0 the id, then the datasets' columns in
+ * the order of `cols` (ints and set flags are exact in a double). */
+enum { SNAP_SCALARS = 6 };
+typedef struct {
+  int w;                       /* doubles per record                                     */
+  unsigned has;                /* bit k: scalar k present (on some rank); bit 30: ids    */
+  int nset;
+} snap_layout;
+
+static const char *const scalar_name[SNAP_SCALARS] = {"J", "Jbar", "eps_p", "region",
+                                                      "pore_pressure", "mass"};
+#define SNAP_HAS_ID (1u << 30)
+
+static const double *scalar_of(const mpmc_particles *p, int k) {
+  const double *a[SNAP_SCALARS] = {p->J, p->Jbar, p->eps_p, p->region, p->pw, p->m};
+  return a[k];
+}
+
+/* The records of this rank's points (ids: p->id, or the index when the points have none). */
+static int snap_records(mpmc_sim sim, const snap_layout *L, double **out) {
+  const mpmc_particles *p = &sim->p;
+  const int n = p->n, d = sim->dim, w = L->w;
+  double *rec = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1) * (size_t)w);
+  MPMC_CHECK(rec, sim->ctx, MPMC_ERR_MEMORY, "output: cannot allocate a buffer for %d points", n);
+  for (size_t q = 0; q < (size_t)n; ++q) {
+    double *r = rec + q * (size_t)w;
+    int k = 0;
+    r[k++] = p->id ? p->id[q] : (double)q;
+    for (int a = 0; a < 3; ++a) r[k++] = a < d ? p->x[q * (size_t)d + a] : 0.0; /* 2D: z = 0 */
+    for (int a = 0; a < 3; ++a) r[k++] = a < d ? p->v[q * (size_t)d + a] : 0.0;
+    for (int c = 0; c < 6; ++c) r[k++] = p->stress[6 * q + c];
+    r[k++] = (p->stress[6 * q] + p->stress[6 * q + 1] + p->stress[6 * q + 2]) / 3.0;
+    for (int s = 0; s < SNAP_SCALARS; ++s)
+      if (L->has >> s & 1u) {
+        const double *a = scalar_of(p, s);
+        r[k++] = a ? a[q] : s < 2 ? 1.0 : 0.0; /* a rank without the field: J, Jbar 1 */
+      }
+    r[k++] = p->mat[q];
+    for (int j = 0; j < L->nset; ++j) r[k + j] = 0.0;
+  }
+  for (int j = 0; j < L->nset; ++j) { /* set membership, one 0/1 column per set */
+    const mpmc_set *set = &sim->sets->s[j];
+    for (int i = 0; i < set->n; ++i)
+      if (set->idx[i] >= 0 && set->idx[i] < n) rec[(size_t)set->idx[i] * (size_t)w + (size_t)(w - L->nset + j)] = 1.0;
+  }
+  *out = rec;
+  return MPMC_SUCCESS;
+}
+
+static int by_id(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+/* Write columns [c0, c0 + nc) of the n records as dataset `name` of ncomp columns (1:
+ * [total]) in the rows from offset; type 0 double, 1 int32, 2 uint8. */
+static herr_t write_cols(hid_t g, const char *name, const double *rec, int n, int w, int c0,
+                         int nc, int type, long long offset, long long total, hid_t dxpl,
+                         void *buf) {
+  for (size_t q = 0; q < (size_t)n; ++q)
+    for (int c = 0; c < nc; ++c) {
+      const double v = rec[q * (size_t)w + (size_t)(c0 + c)];
+      const size_t i = q * (size_t)nc + (size_t)c;
+      if (type == 0)
+        ((double *)buf)[i] = v;
+      else if (type == 1)
+        ((int *)buf)[i] = (int)v;
+      else
+        ((unsigned char *)buf)[i] = (unsigned char)v;
+    }
+  const hid_t ft[3] = {H5T_IEEE_F64LE, H5T_STD_I32LE, H5T_STD_U8LE};
+  const hid_t mt[3] = {H5T_NATIVE_DOUBLE, H5T_NATIVE_INT, H5T_NATIVE_UCHAR};
+  return mpmc_h5_rows_write(g, name, ft[type], mt[type], total, (size_t)(nc > 1 ? nc : 0), offset,
+                            (size_t)n, buf, dxpl);
+}
+
+/* The snapshot's datasets from the records (this rank's rows from offset), each noted for
+ * the XDMF file. */
+static int write_snapshot(mpmc_output out, hid_t g, mpmc_snap *s, const snap_layout *L,
+                          const double *rec, int n, long long offset, long long total) {
   mpmc_sim sim = out->sim;
   mpmc_context ctx = sim->ctx;
-  const mpmc_particles *p = &sim->p;
-  const int n = p->n, d = sim->dim;
+  const int w = L->w;
+  void *buf = malloc(sizeof(double) * 6 * (size_t)(n > 0 ? n : 1));
+  hid_t dxpl = mpmc_io_dxpl(sim);
+  int err = buf && dxpl >= 0 ? MPMC_SUCCESS
+                             : MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "output: cannot allocate a buffer for %d points", n);
   herr_t st = 0;
-  /* vectors */
-  st |= write_padded(g, "position", p->x, n, d, 3, buf);
-  MPMC_CALL(note_field(ctx, s, "position", 3, 0));
-  st |= write_padded(g, "velocity", p->v, n, d, 3, buf);
-  MPMC_CALL(note_field(ctx, s, "velocity", 3, 0));
-  /* stress in Voigt order xx yy zz yz xz xy, and the mean stress tr(sigma)/3 */
-  st |= mpmc_h5_dataset_write(g, "stress", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)n, 6,
-                              p->stress);
-  MPMC_CALL(note_field(ctx, s, "stress", 6, 0));
-  for (size_t q = 0; q < (size_t)n; ++q)
-    buf[q] = (p->stress[6 * q] + p->stress[6 * q + 1] + p->stress[6 * q + 2]) / 3.0;
-  st |= mpmc_h5_dataset_write(g, "mean_stress", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)n, 0,
-                              buf);
-  MPMC_CALL(note_field(ctx, s, "mean_stress", 1, 0));
-  /* scalars the scene has */
-  const struct {
+  typedef struct {
     const char *name;
-    const double *a;
-  } scal[] = {{"J", p->J}, {"Jbar", p->Jbar}, {"eps_p", p->eps_p}, {"region", p->region},
-                 {"pore_pressure", p->pw}, {"mass", p->m}};
-  for (size_t k = 0; k < sizeof scal / sizeof scal[0]; ++k) {
-    if (!scal[k].a) continue;
-    st |= mpmc_h5_dataset_write(g, scal[k].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, (size_t)n, 0,
-                                scal[k].a);
-    MPMC_CALL(note_field(ctx, s, scal[k].name, 1, 0));
+    int nc, type;
+  } column;
+  column col[4 + SNAP_SCALARS + 1];
+  int nd = 0;
+  col[nd++] = (column){"position", 3, 0}; /* 2D padded with z = 0 for ParaView */
+  col[nd++] = (column){"velocity", 3, 0};
+  col[nd++] = (column){"stress", 6, 0};   /* Voigt xx yy zz yz xz xy */
+  col[nd++] = (column){"mean_stress", 1, 0};
+  for (int k = 0; k < SNAP_SCALARS; ++k)
+    if (L->has >> k & 1u) col[nd++] = (column){scalar_name[k], 1, 0};
+  col[nd++] = (column){"material", 1, 1};
+  int c0 = 1;
+  for (int k = 0; k < nd && !err; ++k) {
+    st |= write_cols(g, col[k].name, rec, n, w, c0, col[k].nc, col[k].type, offset, total, dxpl, buf);
+    err = note_field(ctx, s, col[k].name, col[k].nc, col[k].type);
+    c0 += col[k].nc;
   }
-  st |= mpmc_h5_dataset_write(g, "material", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)n, 0, p->mat);
-  MPMC_CALL(note_field(ctx, s, "material", 1, 1));
-  if (p->id) { /* once the points are sorted by cell (sort.c), each point's id to follow it */
-    st |= mpmc_h5_dataset_write(g, "id", H5T_STD_I32LE, H5T_NATIVE_INT, (size_t)n, 0, p->id);
-    MPMC_CALL(note_field(ctx, s, "id", 1, 1));
+  if (!err && (L->has & SNAP_HAS_ID)) { /* each point's id, for ParaView to follow it */
+    st |= write_cols(g, "id", rec, n, w, 0, 1, 1, offset, total, dxpl, buf);
+    err = note_field(ctx, s, "id", 1, 1);
   }
-  /* set membership, one 0/1 array per set */
-  const int nset = sim->sets ? sim->sets->n : 0;
-  for (int k = 0; k < nset; ++k) {
-    const mpmc_set *set = &sim->sets->s[k];
-    memset(mark, 0, (size_t)n);
-    for (int i = 0; i < set->n; ++i)
-      if (set->idx[i] < n) mark[set->idx[i]] = 1;
+  for (int k = 0; k < L->nset && !err; ++k) {
     char name[272];
-    set_dataset_name(name, sizeof name, set->name);
-    st |= mpmc_h5_dataset_write(g, name, H5T_STD_U8LE, H5T_NATIVE_UCHAR, (size_t)n, 0, mark);
-    MPMC_CALL(note_field(ctx, s, name, 1, 2));
+    set_dataset_name(name, sizeof name, sim->sets->s[k].name);
+    st |= write_cols(g, name, rec, n, w, c0 + k, 1, 2, offset, total, dxpl, buf);
+    err = note_field(ctx, s, name, 1, 2);
   }
-  MPMC_CHECK(st >= 0, ctx, MPMC_ERR_IO, "cannot write snapshot %d to '%s'", out->nsnap,
-             out->h5path);
-  return MPMC_SUCCESS;
+  mpmc_io_plist_close(dxpl);
+  free(buf);
+  if (!err && st < 0)
+    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot write snapshot %d to '%s'", out->nsnap, out->h5path);
+  return err;
+}
+
+/* The file's group of snapshot s from the records: opened, written, closed (every rank). */
+static int write_group(mpmc_output out, mpmc_snap *s, const snap_layout *L, const double *rec,
+                       int n, long long offset, long long total) {
+  mpmc_sim sim = out->sim;
+  mpmc_context ctx = sim->ctx;
+  int err = MPMC_SUCCESS;
+  hid_t fapl = mpmc_io_fapl(sim);
+  hid_t f = fapl < 0 ? -1 : H5Fopen(out->h5path, H5F_ACC_RDWR, fapl);
+  mpmc_io_plist_close(fapl);
+  if (f < 0)
+    return MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot open the HDF5 output file '%s' for snapshot %d",
+                      out->h5path, out->nsnap);
+  char gname[32];
+  snprintf(gname, sizeof gname, "snapshot_%06d", out->nsnap);
+  hid_t g = H5Gcreate2(f, gname, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  if (g < 0) {
+    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot create group /%s in '%s'", gname, out->h5path);
+  } else {
+    const int64_t step = s->step;
+    if (mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &s->time) < 0 ||
+        mpmc_h5_attr_write(g, "step", H5T_NATIVE_INT64, 1, &step) < 0)
+      err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot write time/step of /%s", gname);
+    if (!err) err = write_snapshot(out, g, s, L, rec, n, offset, total);
+    H5Gclose(g);
+  }
+  if (H5Fclose(f) < 0 && !err)
+    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot close the HDF5 output file '%s'", out->h5path);
+  return err;
 }
 
 /**
  * @brief Append one snapshot at the current time: position and velocity (padded to 3
  *        components in 2D), stress (Voigt xx yy zz yz xz xy), mean_stress, J, and where the
  *        scene has them Jbar, eps_p; mass, material id, id (the point's index when added,
- *        once the points are sorted: mpmc_sim_set_sort_interval) and set_<name> membership
- *        (0/1).
+ *        once the points are sorted, mpmc_sim_set_sort_interval, and over MPI) and
+ *        set_<name> membership (0/1).  The rows are the points in the order of their ids,
+ *        whatever the storage order, the threads or the number of MPI ranks (over MPI the
+ *        ranks write one file collectively).
  *        The group carries the attributes time and step.  The XDMF file is then rewritten.
  */
 int mpmc_output_write(mpmc_output out) {
   if (!out) return MPMC_ERR_ARG;
   mpmc_sim sim = out->sim;
   mpmc_context ctx = sim->ctx;
-  const int n = sim->p.n;
-  MPMC_CHECK(n > 0, ctx, MPMC_ERR_STATE, "output: no material points to write");
+  long long offset = 0, total = 0;
+  mpmc_io_scan(sim, sim->p.n, &offset, &total);
+  MPMC_CHECK(total > 0, ctx, MPMC_ERR_STATE, "output: no material points to write");
+  MPMC_CHECK(total <= INT32_MAX, ctx, MPMC_ERR_UNSUPPORTED, "output: %lld points", total);
   /* allocate the fields the scene will have from its first step on, so that every snapshot
    * lists the same fields */
-  MPMC_CALL(mpmc_sim_prepare(sim));
-  if (sim->sort_every > 0) { /* the ids, which the first sort would create */
+  int err = mpmc_sim_prepare(sim);
+  if (!err && sim->sort_every > 0) { /* the ids, which the first sort would create */
     const int *ids;
-    MPMC_CALL(mpmc_sim_get_particle_ids(sim, &ids));
+    err = mpmc_sim_get_particle_ids(sim, &ids);
   }
+  err = mpmc_dd_agree(sim, err);
+  if (err) return err;
+  const mpmc_particles *p = &sim->p;
+  snap_layout L = {0, p->id ? SNAP_HAS_ID : 0u, sim->sets ? sim->sets->n : 0};
+  for (int k = 0; k < SNAP_SCALARS; ++k)
+    if (scalar_of(p, k)) L.has |= 1u << k;
+  mpmc_io_or(sim, &L.has, 1); /* a field any rank has is written by all */
+  L.w = 1 + 3 + 3 + 6 + 1 + 1 + L.nset;
+  for (int k = 0; k < SNAP_SCALARS; ++k) L.w += (int)(L.has >> k & 1u);
   if (out->nsnap == out->capsnap) {
     const int cap = out->capsnap ? 2 * out->capsnap : 16;
     mpmc_snap *a = realloc(out->snaps, sizeof *a * (size_t)cap);
@@ -309,47 +442,31 @@ int mpmc_output_write(mpmc_output out) {
   memset(s, 0, sizeof *s);
   s->time = sim->time;
   s->step = sim->stats.steps;
-  s->n = n;
-  double *buf = malloc(sizeof(double) * 3 * (size_t)n);
-  unsigned char *mark = malloc((size_t)n);
-  if (!buf || !mark) {
-    free(buf);
-    free(mark);
-    return MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "output: cannot allocate a buffer for %d points", n);
+  s->n = (int)total;
+  double *rec = NULL;
+  int n = p->n;
+  err = mpmc_dd_agree(sim, snap_records(sim, &L, &rec));
+  if (!err) { /* each rank's block of ids, up to the largest over every rank */
+    double nid = 0.0;
+    for (int q = 0; q < n; ++q) nid = fmax(nid, rec[(size_t)q * (size_t)L.w] + 1.0);
+    mpmc_dd_max(sim, &nid, 1);
+    err = mpmc_io_by_id(sim, &rec, &n, L.w, (long long)nid);
   }
-  mpmc_h5_quiet q;
-  mpmc_h5_quiet_begin(&q);
-  int err = MPMC_SUCCESS;
-  hid_t f = H5Fopen(out->h5path, H5F_ACC_RDWR, H5P_DEFAULT);
-  if (f < 0) {
-    err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot open the HDF5 output file '%s' for snapshot %d",
-                     out->h5path, out->nsnap);
-  } else {
-    char gname[32];
-    snprintf(gname, sizeof gname, "snapshot_%06d", out->nsnap);
-    hid_t g = H5Gcreate2(f, gname, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (g < 0) {
-      err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot create group /%s in '%s'", gname, out->h5path);
-    } else {
-      const int64_t step = s->step;
-      if (mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &s->time) < 0 ||
-          mpmc_h5_attr_write(g, "step", H5T_NATIVE_INT64, 1, &step) < 0)
-        err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot write time/step of /%s", gname);
-      if (!err) err = write_snapshot(out, g, s, buf, mark);
-      H5Gclose(g);
-    }
-    if (H5Fclose(f) < 0 && !err)
-      err = MPMC_ERROR(ctx, MPMC_ERR_IO, "cannot close the HDF5 output file '%s'", out->h5path);
+  if (!err) {
+    qsort(rec, (size_t)n, sizeof(double) * (size_t)L.w, by_id);
+    mpmc_io_scan(sim, n, &offset, &total);
+    mpmc_h5_quiet q;
+    mpmc_h5_quiet_begin(&q);
+    err = mpmc_dd_agree(sim, write_group(out, s, &L, rec, n, offset, total));
+    mpmc_h5_quiet_end(&q);
   }
-  mpmc_h5_quiet_end(&q);
-  free(buf);
-  free(mark);
+  free(rec);
   if (err) {
     free(s->fields);
     return err;
   }
   out->nsnap++;
-  return mpmc_xdmf_write(out);
+  return write_xdmf(out);
 }
 
 /** @brief Close an output series; accepts NULL and sets the handle to NULL. */
