@@ -40,8 +40,9 @@ for scene in "${scenes[@]}"; do
     END {
       printf "== %s, %d points, %d steps, the best of %d rounds (range of ms/step)\n", scene,
         v[1, "points"], v[1, "steps"], rounds
-      printf "%-11s %9s %17s %11s %9s %14s %12s %9s %11s %9s\n", "ranks x thr", "ms/step", "(range)",
-        "outside MPI", "M/s", "points a rank", "halo B/step", "halo msgs", "migr B/step", "migr msgs"
+      printf "%-11s %9s %17s %11s %9s %14s %12s %9s %11s %9s\n", "ranks x thr", "ms/step",
+        "(range)", "outside MPI", "M/s", "points a rank", "halo B/step", "halo msgs", "migr B/step",
+        "migr msgs"
       for (c = 1; c <= 4; ++c)
         printf "%-11s %9.3f %17s %11.3f %9.3f %14s %12d %9.2f %11d %9.2f\n",
           v[c, "ranks"] " x " v[c, "threads"], lo[c], sprintf("(%.3f-%.3f)", lo[c], hi[c]), wo[c],
