@@ -4,71 +4,39 @@
  * LAPACK loaded at the first plastic point).  The hardening variable alpha, the accumulated
  * plastic multiplier, is kept per point as eps_p.  When a return fails, the error names the
  * point, the reason and the derivative that a central-difference check finds wrong. */
-#include <limits.h>
 #include <math.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "linalg.h"
 #include "return_cpp.h"
+#include "stress_return.h"
 
 extern const mpmc_model mpmc_model_user_yield;
 
-static int uy_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
-  (void)dt;
-  mpmc_particles *p = &sim->p;
-  const int d = sim->dim, solver = sim->solver;
-  const mpmc_cpp_param cp = {.K = mat->K, .G = mat->G, .fn = mat->yield_fn, .data = mat->user_data};
-  mpmc_rm_ws **ws;
-  MPMC_CALL(mpmc_rm_sim_workspaces(sim, mpmc_max_threads(), &ws));
-  const double *Jm = sim->fbar ? p->Jbar : p->J;
-  int64_t nret = 0, nfb = 0;
-  int first_bad = INT_MAX;
-#pragma omp parallel reduction(min : first_bad) reduction(+ : nret, nfb) if (p->n > MPMC_OMP_MIN)
-  {
-    int tid = 0;
-#ifdef _OPENMP
-    tid = omp_get_thread_num();
-#endif
-    mpmc_rm_ws *w = ws[tid];
-#pragma omp for schedule(static)
-    for (int q = 0; q < p->n; ++q) {
-      if (p->mat[q] != id) continue;
-      double F[3][3], tau[6], Je;
-      mpmc_embed(d, p->dF + (size_t)q * d * d, F);
-      mpmc_cpp_info info;
-      info.plastic = info.fallback = 0;
-      /* be and eps_p are left unchanged on failure */
-      const int err = mpmc_cpp_return_map(w, solver, &cp, F, p->be + (size_t)q * 6,
-                                          p->eps_p + q, tau, &Je, &info);
-      if (err || !mpmc_stress_finite(tau) || !(Jm[q] > 0)) {
-        if (q < first_bad) first_bad = q;
-        continue;
-      }
-      double *s = p->stress + (size_t)q * 6;
-      for (int k = 0; k < 6; ++k) s[k] = tau[k] / Jm[q];
-      if (p->pw) /* effective to total stress under a water table (water.c) */
-        for (int k = 0; k < 3; ++k) s[k] -= p->pw[q];
-      nret += info.plastic;
-      nfb += info.fallback;
-    }
-  }
-  sim->stats.return_maps += nret;
-  sim->stats.kinsol_fallbacks += nfb;
-  if (first_bad == INT_MAX) return MPMC_SUCCESS;
-  /* repeat the failed point alone, then check the function's derivatives at its trial
-   * state: a wrong derivative is the usual cause */
-  const int q = first_bad;
-  double F[3][3], be[6], tau[6], Je, alpha = p->eps_p[q];
-  mpmc_embed(d, p->dF + (size_t)q * d * d, F);
-  for (int k = 0; k < 6; ++k) be[k] = p->be[(size_t)q * 6 + k];
+/* one point's return (stress_return.h), model: the material's mpmc_cpp_param */
+static int uy_point(const void *model, mpmc_rm_ws *ws, int solver, double F[3][3],
+                    double be[6], double *eps_p, double tau[6], mpmc_return_out *out) {
+  mpmc_cpp_info info;
+  info.plastic = info.fallback = 0;
+  const int err = mpmc_cpp_return_map(ws, solver, model, F, be, eps_p, tau, &out->Je, &info);
+  out->plastic = info.plastic;
+  out->fallback = info.fallback;
+  return err;
+}
+
+/* repeat the failed point alone, then check the function's derivatives at its trial state:
+ * a wrong derivative is the usual cause */
+static int uy_fail(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, const void *model,
+                   mpmc_rm_ws *ws, mpmc_return_point *pt) {
+  const mpmc_particles *p = &sim->p;
+  const mpmc_cpp_param *cp = model;
+  const int q = pt->q, solver = sim->solver;
+  double tau[6], Je;
   mpmc_cpp_info info = {0};
-  int err = mpmc_cpp_return_map(ws[0], solver, &cp, F, be, &alpha, tau, &Je, &info);
+  int err = mpmc_cpp_return_map(ws, solver, cp, pt->F, pt->be, &pt->eps_p, tau, &Je, &info);
   char deriv[200] = "";
   double btr[6], lam[3], Q[3][3], eps[3], t[3];
   for (int k = 0; k < 6; ++k) btr[k] = p->be[(size_t)q * 6 + k];
-  mpmc_push_forward(F, btr);
+  mpmc_push_forward(pt->F, btr);
   mpmc_sym3_eig(btr, lam, Q);
   if (lam[0] > 0 && lam[1] > 0 && lam[2] > 0) {
     for (int a = 0; a < 3; ++a) eps[a] = 0.5 * log(lam[a]);
@@ -77,22 +45,28 @@ static int uy_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, d
     double ttr[6], worst = 0;
     char name[64] = "";
     mpmc_sym3_compose(t, Q, ttr);
-    if (!mpmc_cpp_check_derivatives(&cp, ttr, p->eps_p[q], &worst, name, sizeof name) &&
+    if (!mpmc_cpp_check_derivatives(cp, ttr, p->eps_p[q], &worst, name, sizeof name) &&
         worst > 1e-4)
       snprintf(deriv, sizeof deriv,
                "; at the trial stress the function's %s differs from central differences by "
                "%.3g relative: check the yield function's derivatives",
                name, worst);
   }
-  const double *x = p->x + (size_t)q * d;
-  char nb[MPMC_POINT_NAME_LEN];
   if (!err) err = MPMC_ERR_NUMERIC;
   return MPMC_ERROR(sim->ctx, err,
                     "step %lld, t = %g: user yield surface (material %d, solver %s) failed at "
                     "point %s (%g, %g, %g): %s%s",
                     (long long)sim->stats.steps, sim->time, id, mpmc_solver_name(solver),
-                    mpmc_point_name(p, q, nb), x[0], x[1], d == 3 ? x[2] : 0.0,
+                    pt->name, pt->x[0], pt->x[1], pt->x[2],
                     info.message[0] ? info.message : "non-finite stress", deriv);
+}
+
+static const mpmc_return_ops uy_return = {uy_point, uy_fail};
+
+static int uy_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
+  (void)dt;
+  const mpmc_cpp_param cp = {.K = mat->K, .G = mat->G, .fn = mat->yield_fn, .data = mat->user_data};
+  return mpmc_return_update(sim, mat, id, &uy_return, &cp);
 }
 
 static double uy_wave_speed(const mpmc_material *m) {
