@@ -13,10 +13,12 @@
  * middle of that axis, x in [0.75, 1.25], so the cut halves it).  Rank 0 prints one line of
  * key=value pairs: the wall time per step and the busiest rank's time outside MPI calls (the
  * time in them, MPI_Waitall's and the collectives', is waiting for the neighbours: for their
- * work, or on a loaded machine for their turn on a core), points x steps per second, the
- * points per rank, and per step and rank (the largest over the ranks) the bytes and messages
- * each rank sent:
- * halo sums (P2G's and F-bar's), migration (the counts and the points), collectives.
+ * work, or on a loaded machine for their turn on a core), the CPU time outside MPI calls of
+ * the busiest rank and of all ranks (the work, whatever the load: with one thread a rank, the
+ * ratio of one rank's to the busiest rank's is the speed-up free cores would give, but for
+ * the waits' latency), points x steps per second, the points per rank, and per step and rank
+ * (the largest over the ranks) the bytes and messages each rank sent: halo sums (P2G's and
+ * F-bar's), migration (the counts and the points), collectives.
  *
  * Halo and migration traffic are libmpmc's counts (mpmc_sim_get_mpi_traffic).  The
  * collectives, which it does not count, are counted with the MPI profiling interface: this
@@ -50,10 +52,16 @@ static const char *const kind_name[K_COUNT] = {"halo", "migration", "p2p", "allr
                                                "allgather", "bcast"};
 static double sent_bytes[K_COUNT];
 static long sent_msgs[K_COUNT];
-static double mpi_seconds; /* wall time inside the MPI calls below */
+static double mpi_seconds, mpi_cpu; /* wall and CPU time inside the MPI calls below */
 
-static int timed(int rc, double t0) {
+static double cpu_now(clockid_t clock) {
+  struct timespec ts;
+  clock_gettime(clock, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+static int timed(int rc, double t0, double c0) {
   mpi_seconds += PMPI_Wtime() - t0;
+  mpi_cpu += cpu_now(CLOCK_THREAD_CPUTIME_ID) - c0;
   return rc;
 }
 
@@ -70,42 +78,42 @@ static void count_p2p(int n, MPI_Datatype type, int dest) {
 int MPI_Isend(const void *buf, int n, MPI_Datatype type, int dest, int tag, MPI_Comm comm,
               MPI_Request *req) {
   count_p2p(n, type, dest);
-  const double t0 = PMPI_Wtime();
-  return timed(PMPI_Isend(buf, n, type, dest, tag, comm, req), t0);
+  const double t0 = PMPI_Wtime(), c0 = cpu_now(CLOCK_THREAD_CPUTIME_ID);
+  return timed(PMPI_Isend(buf, n, type, dest, tag, comm, req), t0, c0);
 }
 int MPI_Send(const void *buf, int n, MPI_Datatype type, int dest, int tag, MPI_Comm comm) {
   count_p2p(n, type, dest);
-  const double t0 = PMPI_Wtime();
-  return timed(PMPI_Send(buf, n, type, dest, tag, comm), t0);
+  const double t0 = PMPI_Wtime(), c0 = cpu_now(CLOCK_THREAD_CPUTIME_ID);
+  return timed(PMPI_Send(buf, n, type, dest, tag, comm), t0, c0);
 }
 int MPI_Sendrecv(const void *sbuf, int sn, MPI_Datatype stype, int dest, int stag, void *rbuf,
                  int rn, MPI_Datatype rtype, int src, int rtag, MPI_Comm comm,
                  MPI_Status *status) {
   count_p2p(sn, stype, dest);
-  const double t0 = PMPI_Wtime();
+  const double t0 = PMPI_Wtime(), c0 = cpu_now(CLOCK_THREAD_CPUTIME_ID);
   return timed(PMPI_Sendrecv(sbuf, sn, stype, dest, stag, rbuf, rn, rtype, src, rtag, comm, status),
-               t0);
+               t0, c0);
 }
 int MPI_Allreduce(const void *sbuf, void *rbuf, int n, MPI_Datatype type, MPI_Op op,
                   MPI_Comm comm) {
   count(K_ALLREDUCE, n, type);
-  const double t0 = PMPI_Wtime();
-  return timed(PMPI_Allreduce(sbuf, rbuf, n, type, op, comm), t0);
+  const double t0 = PMPI_Wtime(), c0 = cpu_now(CLOCK_THREAD_CPUTIME_ID);
+  return timed(PMPI_Allreduce(sbuf, rbuf, n, type, op, comm), t0, c0);
 }
 int MPI_Allgather(const void *sbuf, int sn, MPI_Datatype stype, void *rbuf, int rn,
                   MPI_Datatype rtype, MPI_Comm comm) {
   count(K_ALLGATHER, sn, stype);
-  const double t0 = PMPI_Wtime();
-  return timed(PMPI_Allgather(sbuf, sn, stype, rbuf, rn, rtype, comm), t0);
+  const double t0 = PMPI_Wtime(), c0 = cpu_now(CLOCK_THREAD_CPUTIME_ID);
+  return timed(PMPI_Allgather(sbuf, sn, stype, rbuf, rn, rtype, comm), t0, c0);
 }
 int MPI_Bcast(void *buf, int n, MPI_Datatype type, int root, MPI_Comm comm) {
   count(K_BCAST, n, type);
-  const double t0 = PMPI_Wtime();
-  return timed(PMPI_Bcast(buf, n, type, root, comm), t0);
+  const double t0 = PMPI_Wtime(), c0 = cpu_now(CLOCK_THREAD_CPUTIME_ID);
+  return timed(PMPI_Bcast(buf, n, type, root, comm), t0, c0);
 }
 int MPI_Waitall(int n, MPI_Request reqs[], MPI_Status *statuses) {
-  const double t0 = PMPI_Wtime();
-  return timed(PMPI_Waitall(n, reqs, statuses), t0);
+  const double t0 = PMPI_Wtime(), c0 = cpu_now(CLOCK_THREAD_CPUTIME_ID);
+  return timed(PMPI_Waitall(n, reqs, statuses), t0, c0);
 }
 
 /* ---- one run ------------------------------------------------------------------------- */
@@ -115,6 +123,9 @@ int MPI_Waitall(int n, MPI_Request reqs[], MPI_Status *statuses) {
 typedef struct {
   double seconds;                           /* wall time of the timed steps (rank 0's)  */
   double outside;                           /* of it outside MPI calls, the busiest rank */
+  double cpu_max, cpu_sum;                  /* CPU time outside MPI calls: the busiest
+                                               rank's, all ranks' (waiting for a core
+                                               excluded)                                  */
   long points, pmin, pmax;                  /* over the ranks                            */
   double bytes[K_COUNT], msgs[K_COUNT];     /* per step, this rank                       */
   long area;                                /* nodes of the active box's cross-section
@@ -160,17 +171,20 @@ static result run(MPI_Comm comm, int centred, int threads, int steps) {
   for (int s = 0; s < 3; ++s) CHECK(mpmc_sim_step(sim, dt)); /* warm-up: allocations */
   memset(sent_bytes, 0, sizeof sent_bytes);
   memset(sent_msgs, 0, sizeof sent_msgs);
-  mpi_seconds = 0.0;
+  mpi_seconds = mpi_cpu = 0.0;
   double lib0[2], lib1[2];
   long libm0[2], libm1[2];
   CHECK(mpmc_sim_get_mpi_traffic(sim, &lib0[0], &libm0[0], &lib0[1], &libm0[1]));
   MPI_Barrier(comm);
-  const double t0 = MPI_Wtime();
+  const double t0 = MPI_Wtime(), c0 = cpu_now(CLOCK_PROCESS_CPUTIME_ID);
   for (int s = 0; s < steps; ++s) CHECK(mpmc_sim_step(sim, dt));
+  const double cpu = cpu_now(CLOCK_PROCESS_CPUTIME_ID) - c0 - mpi_cpu;
   MPI_Barrier(comm);
   result r = {.seconds = MPI_Wtime() - t0};
   const double outside = r.seconds - mpi_seconds;
   MPI_Allreduce(&outside, &r.outside, 1, MPI_DOUBLE, MPI_MAX, comm);
+  MPI_Allreduce(&cpu, &r.cpu_max, 1, MPI_DOUBLE, MPI_MAX, comm);
+  MPI_Allreduce(&cpu, &r.cpu_sum, 1, MPI_DOUBLE, MPI_SUM, comm);
   CHECK(mpmc_sim_get_mpi_traffic(sim, &lib1[0], &libm1[0], &lib1[1], &libm1[1]));
   for (int k = 0; k < 2; ++k) {
     sent_bytes[K_HALO + k] = lib1[k] - lib0[k];
@@ -390,9 +404,10 @@ int main(int argc, char **argv) {
     largest(MPI_COMM_WORLD, &r);
     if (my_rank == 0) {
       printf("scene=%s ranks=%d threads=%d points=%ld steps=%d ms_per_step=%.3f "
-             "outside_mpi_ms_per_step=%.3f Mpoint_steps_per_s=%.3f points_per_rank=%ld..%ld",
+             "outside_mpi_ms_per_step=%.3f cpu_outside_mpi_ms_per_step=%.3f "
+             "cpu_outside_mpi_all_ranks=%.3f Mpoint_steps_per_s=%.3f points_per_rank=%ld..%ld",
              sc ? "centred" : "column", size, threads, r.points, steps, 1e3 * r.seconds / steps,
-             1e3 * r.outside / steps,
+             1e3 * r.outside / steps, 1e3 * r.cpu_max / steps, 1e3 * r.cpu_sum / steps,
              (double)r.points * steps / r.seconds / 1e6, r.pmin, r.pmax);
       for (int k = 0; k < K_COUNT; ++k)
         if (k != K_P2P) /* halo + migration */
