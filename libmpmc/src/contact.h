@@ -33,5 +33,7 @@ struct mpmc_bodies_s {
  * rest: NaN, out of contact); contact_barrier.c and sort.c. */
 struct mpmc_sim_s;
 int mpmc_contact_grow_anchors(struct mpmc_sim_s *sim, mpmc_body *b);
+/* The same for the first n points (mpi.c: before arrivals are written). */
+int mpmc_contact_reserve_anchors(struct mpmc_sim_s *sim, mpmc_body *b, int n);
 
 #endif

@@ -130,12 +130,15 @@ static void contact_params(const struct mpmc_sim_s *sim, double *dhat, double *k
   const int d = sim->dim;
   const double h = sim->grid.h;
   double l = 0.5 * h;
+  double sn[2] = {0.0, p->n}; /* the volumes' sum and the points, over the ranks over MPI */
   if (p->n > 0) {
     double s = 0.0;
 #pragma omp parallel for reduction(+ : s) schedule(static) if (p->n > CONTACT_PAR_MIN)
     for (int q = 0; q < p->n; ++q) s += p->vol0[q];
-    l = pow(s / p->n, 1.0 / d);
+    sn[0] = s;
   }
+  mpmc_dd_sum(sim, sn, 2);
+  if (sn[1] > 0) l = pow(sn[0] / sn[1], 1.0 / d);
   double M = 0.0;
   for (int m = 0; m < sim->nmat; ++m) {
     const double c = sim->mats[m].ops->wave_speed(&sim->mats[m]);
@@ -156,7 +159,10 @@ static inline double point_area(int dim, double vol0) {
 /* ---- internal entry points (mpmc_impl.h) ---------------------------------------------- */
 
 int mpmc_contact_grow_anchors(struct mpmc_sim_s *sim, mpmc_body *b) {
-  const int n = sim->p.n;
+  return mpmc_contact_reserve_anchors(sim, b, sim->p.n);
+}
+
+int mpmc_contact_reserve_anchors(struct mpmc_sim_s *sim, mpmc_body *b, int n) {
   if (b->nanchor >= n) return MPMC_SUCCESS;
   double *a = realloc(b->anchor, sizeof *a * 3 * (size_t)n);
   MPMC_CHECK(a, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate friction anchors of %d points", n);
@@ -179,11 +185,12 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
   for (long i = 0; i < nd; ++i) cf[i] = 0.0;
   double dhat, kappa;
   contact_params(sim, &dhat, &kappa);
-  for (int bi = 0; bi < B->n; ++bi) {
+  int err = MPMC_SUCCESS;
+  for (int bi = 0; bi < B->n && !err; ++bi) {
     mpmc_body *b = &B->b[bi];
     if (!b->active) continue;
     const double mu = b->mu;
-    if (mu > 0.0) MPMC_CALL(mpmc_contact_grow_anchors(sim, b));
+    if (mu > 0.0 && (err = mpmc_contact_grow_anchors(sim, b))) break;
     double *restrict anc = mu > 0.0 ? b->anchor : NULL;
     const double vb[3] = {b->v[0], b->v[1], b->v[2]};
     double r0 = 0.0, r1 = 0.0, r2 = 0.0;
@@ -254,21 +261,29 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
       double n[3];
       const double *x = p->x + (size_t)bad * d;
       char nb[MPMC_POINT_NAME_LEN];
-      return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
-                        "step %lld, t = %g: point %s at (%g, %g, %g) is inside rigid body %d "
-                        "(gap %g <= 0)",
-                        (long long)sim->stats.steps, sim->time, mpmc_point_name(p, bad, nb), x[0], x[1],
-                        d == 3 ? x[2] : 0.0, bi, body_gap(b, d, x, n));
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,
+                       "step %lld, t = %g: point %s at (%g, %g, %g) is inside rigid body %d "
+                       "(gap %g <= 0)",
+                       (long long)sim->stats.steps, sim->time, mpmc_point_name(p, bad, nb), x[0], x[1],
+                       d == 3 ? x[2] : 0.0, bi, body_gap(b, d, x, n));
+      break;
     }
     b->reaction[0] = r0;
     b->reaction[1] = r1;
     b->reaction[2] = r2;
     for (int a = 0; a < d; ++a) b->offset[a] += dt * b->v[a];
   }
-  return MPMC_SUCCESS;
+  if (!sim->dd) return err;
+  /* MPI: the reactions over the ranks, summed in rank order (the same bits on every rank),
+   * once every rank got through */
+  err = mpmc_dd_agree(sim, err);
+  for (int bi = 0; bi < B->n && !err; ++bi)
+    if (B->b[bi].active) mpmc_dd_sum(sim, B->b[bi].reaction, 3);
+  return err;
 }
 
-/* The smallest gap of any point to body b, and that point (-1 without points). */
+/* The smallest gap of any point to body b, and that point (-1 without points): its index,
+ * over MPI its global id (of the points with that gap, the least id; collective). */
 static double min_gap(const struct mpmc_sim_s *sim, const mpmc_body *b, int *point) {
   const mpmc_particles *p = &sim->p;
   const int d = sim->dim;
@@ -280,7 +295,15 @@ static double min_gap(const struct mpmc_sim_s *sim, const mpmc_body *b, int *poi
     if (g < gmin) gmin = g;
   }
   int qmin = -1;
-  for (int q = 0; q < p->n && qmin < 0; ++q) {
+  if (sim->dd) {
+    for (int q = 0; q < p->n; ++q) {
+      double n[3];
+      const int id = p->id ? p->id[q] : q;
+      if (body_gap(b, d, p->x + (size_t)q * d, n) == gmin && (qmin < 0 || id < qmin)) qmin = id;
+    }
+    mpmc_dd_minloc(sim, &gmin, &qmin);
+  }
+  for (int q = 0; q < p->n && qmin < 0 && !sim->dd; ++q) {
     double n[3];
     if (body_gap(b, d, p->x + (size_t)q * d, n) == gmin) qmin = q;
   }
@@ -366,7 +389,9 @@ double mpmc_contact_stable_dt(const struct mpmc_sim_s *sim) {
     const double r = p->m[q] / (point_area(d, p->vol0[q]) * kappa * g);
     if (r < rmin) rmin = r;
   }
-  return 2.0 * sqrt(rmin);
+  double neg = -rmin; /* MPI: the least over the ranks (collective) */
+  mpmc_dd_max(sim, &neg, 1);
+  return 2.0 * sqrt(-neg);
 }
 
 void mpmc_contact_free(struct mpmc_sim_s *sim) {
@@ -527,7 +552,8 @@ int mpmc_sim_get_rigid_reaction(const mpmc_sim sim, int id, double *f) {
 
 /**
  * @brief The smallest signed distance from any material point to a rigid body's surface
- *        (negative inside) and that point (-1 and +inf without points).
+ *        (negative inside) and that point (-1 and +inf without points); over MPI the
+ *        smallest over every rank's points and the point's global id (collective).
  */
 int mpmc_sim_get_rigid_gap(const mpmc_sim sim, int id, double *gap, int *point) {
   if (!sim) return MPMC_ERR_ARG;

@@ -36,6 +36,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "contact.h"
 #include "mpmc_impl.h"
 #include "sets.h"
 
@@ -49,6 +50,7 @@ int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) { return (void)s
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) { return (void)sim, (void)v, 1; }
+void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id) { (void)sim, (void)v, (void)id; }
 void mpmc_dd_free(struct mpmc_sim_s *sim) { (void)sim; }
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return (void)sim, 1; }
 
@@ -292,6 +294,17 @@ int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) {
   return out.r == dd->rank;
 }
 
+void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id) {
+  if (!sim->dd) return;
+  struct {
+    double v;
+    int id;
+  } in = {*v, *id >= 0 ? *id : INT_MAX}, out;
+  MPI_Allreduce(&in, &out, 1, MPI_DOUBLE_INT, MPI_MINLOC, sim->dd->comm);
+  *v = out.v;
+  *id = out.id == INT_MAX ? -1 : out.id;
+}
+
 /* ---- halo sums ---------------------------------------------------------------------- */
 
 static int reserve_buf(struct mpmc_sim_s *sim, size_t each) {
@@ -492,13 +505,14 @@ static int fields_of(struct mpmc_sim_s *sim, field *f) {
   f[k++] = (field){&p->eps_p, 1, 0.0};
   f[k++] = (field){&p->region, 1, 0.0};
   f[k++] = (field){&p->Jp, 1, 1.0};
+  f[k++] = (field){&p->pw, 1, 0.0};
   f[k++] = (field){&p->lp, 1, 0.0};
   f[k++] = (field){&p->force, d, 0.0};
   f[k++] = (field){&p->cforce, d, 0.0};
   f[k++] = (field){&p->ustate, p->nustate, 0.0};
   return k;
 }
-#define MAX_FIELDS 17
+#define MAX_FIELDS 18
 
 /* Make sure the optional field f exists here (a sender had it). */
 static int ensure_field(struct mpmc_sim_s *sim, const field *f) {
@@ -519,21 +533,114 @@ static int record_len(const field *f, int nf, unsigned mask, int nsets) {
   return len;
 }
 
-int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
+/* Move the rows of the staying points (map[q] >= 0) of a [n][nc] array to map[q]. */
+static void compact(double *a, int nc, const int *map, int n) {
+  for (int q = 0; q < n; ++q)
+    if (map[q] >= 0 && map[q] != q)
+      memcpy(a + (size_t)map[q] * (size_t)nc, a + (size_t)q * (size_t)nc, (size_t)nc * sizeof(double));
+}
+
+/* Append one arriving point from its record o (fields of the sender's mask msk). */
+static void unpack_point(struct mpmc_sim_s *sim, const field *f, int nf, unsigned msk, int nsets,
+                         const double *o) {
+  mpmc_particles *p = &sim->p;
+  const int q = p->n++;
+  int k = 0;
+  p->mat[q] = (int)o[k++];
+  p->id[q] = (int)o[k++];
+  for (int t = 0; t < nsets; ++t)
+    if (o[k++] != 0.0) {
+      mpmc_set *st = &sim->sets->s[t];
+      st->idx[st->n++] = q;
+    }
+  for (int i = 0; i < nf; ++i) {
+    if (!*f[i].a || f[i].nc <= 0) continue;
+    double *a = *f[i].a + (size_t)q * f[i].nc;
+    if (msk >> i & 1u) {
+      for (int c = 0; c < f[i].nc; ++c) a[c] = o[k++];
+    } else {
+      for (int c = 0; c < f[i].nc; ++c) a[c] = isnan(f[i].fill) ? (c < 3) : f[i].fill;
+    }
+  }
+  for (int b = 0; sim->bodies && b < sim->bodies->n; ++b) {
+    mpmc_body *B = &sim->bodies->b[b];
+    if (B->mu > 0.0)
+      for (int c = 0; c < 3; ++c) B->anchor[3 * (size_t)q + c] = o[k++];
+  }
+}
+
+/* Bodies with friction (mu > 0): each point carries 3 anchor values per such body (NaN:
+ * out of contact), the same bodies on every rank. */
+static int anchor_bodies(const struct mpmc_sim_s *sim) {
+  int k = 0;
+  for (int b = 0; sim->bodies && b < sim->bodies->n; ++b) k += sim->bodies->b[b].mu > 0.0;
+  return k;
+}
+
+/* The anchors of every body with friction cover n points (new ones NaN). */
+static int reserve_anchors(struct mpmc_sim_s *sim, int n, int only_allocated) {
+  for (int b = 0; sim->bodies && b < sim->bodies->n; ++b) {
+    mpmc_body *B = &sim->bodies->b[b];
+    if (B->mu > 0.0 && (B->anchor || !only_allocated))
+      MPMC_CALL(mpmc_contact_reserve_anchors(sim, B, n));
+  }
+  return MPMC_SUCCESS;
+}
+
+/* A migration header per destination: points, field mask, sets, bodies with anchors. */
+enum { HDR = 4 };
+
+/* Doubles per point of a sender's header h. */
+static size_t sender_len(const field *f, int nf, const int *h) {
+  return (size_t)record_len(f, nf, (unsigned)h[1], h[2]) + 3 * (size_t)h[3];
+}
+
+/* Exchange count ints per rank of snd into rcv (int) or doubles (at displacements) with the
+ * neighbours only (far == 0) or with every rank (far == 1), counting what is sent. */
+static void exchange(struct mpmc_dd_s *dd, int far, MPI_Datatype type, const void *snd,
+                     const int *scount, const int *sdispl, void *rcv, const int *rcount,
+                     const int *rdispl, int tag) {
+  const size_t size = type == MPI_INT ? sizeof(int) : sizeof(double);
+  if (far) {
+    MPI_Alltoallv(snd, scount, sdispl, type, rcv, rcount, rdispl, type, dd->comm);
+    for (int r = 0; r < dd->size; ++r)
+      if (r != dd->rank && (scount[r] > 0 || type == MPI_INT))
+        count_sent(&dd->migrate_bytes, &dd->migrate_msgs, r, (size_t)scount[r], size);
+    return;
+  }
+  MPI_Request req[4];
+  int k = 0;
+  for (int s = -1; s <= 1; s += 2) {
+    const int r = dd->rank + s;
+    if (r < 0 || r >= dd->size) continue;
+    MPI_Irecv((char *)rcv + size * (size_t)rdispl[r], rcount[r], type, r, tag, dd->comm, &req[k++]);
+    MPI_Isend((const char *)snd + size * (size_t)sdispl[r], scount[r], type, r, tag, dd->comm, &req[k++]);
+    count_sent(&dd->migrate_bytes, &dd->migrate_msgs, r, (size_t)scount[r], size);
+  }
+  MPI_Waitall(k, req, MPI_STATUSES_IGNORE);
+}
+
+/* Points whose cell is not in this rank's slab go, with all their state, to the rank whose
+ * slab holds it: a neighbour after a step (far == 0; further fails), any rank after the
+ * cuts moved (far == 1, a load balance).  Arrivals are appended in their senders' rank
+ * order, each sender's in its storage order. */
+static int migrate(struct mpmc_sim_s *sim, int far) {
   struct mpmc_dd_s *dd = sim->dd;
-  if (!dd || dd->size == 1) return MPMC_SUCCESS;
   mpmc_context ctx = sim->ctx;
   mpmc_particles *p = &sim->p;
-  const int n = p->n, me = dd->rank;
-  /* where each point goes: -1 down, 0 stays, 1 up; a point beyond a neighbour fails */
-  signed char *dest = malloc((size_t)(n > 0 ? n : 1));
-  int err = dest ? MPMC_SUCCESS : MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
-  int nout[2] = {0, 0};
+  const int n = p->n, me = dd->rank, P = dd->size;
+  int *dest = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+  /* per rank: headers sent and received, then counts and displacements (doubles) */
+  int *ib = calloc((size_t)P * (2 * HDR + 4), sizeof(int));
+  int err = dest && ib ? MPMC_SUCCESS : MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
+  int *hs = ib, *hr = hs + (size_t)P * HDR, *sc = hr + (size_t)P * HDR, *sd = sc + P, *rc = sd + P,
+      *rd = rc + P;
+  int nout = 0;
   for (int q = 0; q < n && !err; ++q) {
     const int c = slab_cell(sim, p->x + (size_t)q * sim->dim);
     const int r = c < dd->cut[me] || c >= dd->cut[me + 1] ? rank_of_cell(dd, c) : me;
-    dest[q] = (signed char)(r < me ? -1 : r > me);
-    if (r < me - 1 || r > me + 1) {
+    dest[q] = r;
+    if (!far && (r < me - 1 || r > me + 1)) {
       char nb[MPMC_POINT_NAME_LEN];
       const double *x = p->x + (size_t)q * sim->dim;
       err = MPMC_ERROR(ctx, MPMC_ERR_UNSTABLE,
@@ -544,12 +651,15 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
                        x[1], sim->dim == 3 ? x[2] : 0.0, me, dd->cut[me], dd->cut[me + 1] - 1,
                        dd->axis, r);
     } else if (r != me) {
-      nout[r > me]++;
+      hs[(size_t)r * HDR]++;
+      nout++;
     }
   }
+  if (!err) err = reserve_anchors(sim, n, 1); /* points added since the last contact pass */
   err = mpmc_dd_agree(sim, err);
   if (err) {
     free(dest);
+    free(ib);
     return err;
   }
   field f[MAX_FIELDS];
@@ -557,29 +667,38 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
   unsigned mask = 0;
   for (int k = 0; k < nf; ++k)
     if (*f[k].a && f[k].nc > 0) mask |= 1u << k;
-  const int nsets = sim->sets ? sim->sets->n : 0;
-  const int len = record_len(f, nf, mask, nsets);
-  /* counts and masks first: [points, field mask, sets] */
-  int hs[2][3] = {{nout[0], (int)mask, nsets}, {nout[1], (int)mask, nsets}}, hr[2][3] = {{0}};
-  MPI_Request req[4];
-  MPI_Irecv(hr[0], 3, MPI_INT, lower(dd), TAG_MIGRATE_N, dd->comm, &req[0]);
-  MPI_Irecv(hr[1], 3, MPI_INT, upper(dd), TAG_MIGRATE_N, dd->comm, &req[1]);
-  MPI_Isend(hs[0], 3, MPI_INT, lower(dd), TAG_MIGRATE_N, dd->comm, &req[2]);
-  MPI_Isend(hs[1], 3, MPI_INT, upper(dd), TAG_MIGRATE_N, dd->comm, &req[3]);
-  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, lower(dd), 3, sizeof(int));
-  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, upper(dd), 3, sizeof(int));
-  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
-  size_t rlen[2];
-  for (int s = 0; s < 2; ++s) {
-    rlen[s] = (size_t)hr[s][0] * (size_t)record_len(f, nf, (unsigned)hr[s][1], hr[s][2]);
-    if (hr[s][0] > 0 && hr[s][2] != nsets && !err)
+  const int nsets = sim->sets ? sim->sets->n : 0, nanc = anchor_bodies(sim);
+  const int len = record_len(f, nf, mask, nsets) + 3 * nanc;
+  for (int r = 0; r < P; ++r) {
+    int *h = hs + (size_t)r * HDR;
+    h[1] = (int)mask;
+    h[2] = nsets;
+    h[3] = nanc;
+    sc[r] = rc[r] = HDR;
+    sd[r] = rd[r] = r * HDR;
+  }
+  exchange(dd, far, MPI_INT, hs, sc, sd, hr, rc, rd, TAG_MIGRATE_N);
+  size_t stot = 0, rtot = 0;
+  int nin = 0;
+  for (int r = 0; r < P; ++r) {
+    const int *h = hr + (size_t)r * HDR;
+    sd[r] = (int)stot;
+    sc[r] = hs[(size_t)r * HDR] * len;
+    stot += (size_t)sc[r];
+    rd[r] = (int)rtot;
+    rc[r] = r == me ? 0 : (int)((size_t)h[0] * sender_len(f, nf, h));
+    rtot += (size_t)rc[r];
+    if (r == me || h[0] <= 0) continue;
+    nin += h[0];
+    if ((h[2] != nsets || h[3] != nanc) && !err)
       err = MPMC_ERROR(ctx, MPMC_ERR_STATE,
-                       "migration: rank %d has %d particle sets, its neighbour %d: add sets on "
-                       "every rank alike", me, nsets, hr[s][2]);
+                       "migration: rank %d has %d particle sets and %d rigid bodies with "
+                       "friction, rank %d %d and %d: add sets and bodies on every rank alike",
+                       me, nsets, nanc, r, h[2], h[3]);
   }
   /* set membership of this rank's points, one flag array per set */
   int *member = NULL;
-  if (nsets > 0 && (nout[0] || nout[1])) {
+  if (nsets > 0 && nout) {
     member = calloc((size_t)nsets * (size_t)(n > 0 ? n : 1), sizeof(int));
     if (!member && !err) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
     for (int k = 0; k < nsets && member; ++k) {
@@ -588,22 +707,21 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
         if (st->idx[j] >= 0 && st->idx[j] < n) member[(size_t)k * n + st->idx[j]] = 1;
     }
   }
-  const size_t slen[2] = {(size_t)nout[0] * (size_t)len, (size_t)nout[1] * (size_t)len};
-  double *sb = malloc(sizeof(double) * (slen[0] + slen[1] + rlen[0] + rlen[1] + 1));
+  double *sb = malloc(sizeof(double) * (stot + rtot + 1));
   if (!sb && !err) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory for the messages");
   err = mpmc_dd_agree(sim, err);
   if (err) {
     free(dest);
+    free(ib);
     free(member);
     free(sb);
     return err;
   }
-  double *out[2] = {sb, sb + slen[0]}, *in[2] = {sb + slen[0] + slen[1], sb + slen[0] + slen[1] + rlen[0]};
-  size_t pos[2] = {0, 0};
-  for (int q = 0; q < n; ++q) {
-    if (!dest[q]) continue;
-    const int s = dest[q] > 0;
-    double *o = out[s] + pos[s];
+  double *rb = sb + stot;
+  size_t *pos = calloc((size_t)P, sizeof(size_t));
+  for (int q = 0; q < n && pos; ++q) {
+    if (dest[q] == me) continue;
+    double *o = sb + sd[dest[q]] + pos[dest[q]];
     int k = 0;
     o[k++] = p->mat[q];
     o[k++] = p->id ? p->id[q] : q;
@@ -611,30 +729,30 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
     for (int i = 0; i < nf; ++i)
       if (mask >> i & 1u)
         for (int c = 0; c < f[i].nc; ++c) o[k++] = (*f[i].a)[(size_t)q * f[i].nc + c];
-    pos[s] += (size_t)len;
+    for (int b = 0; sim->bodies && b < sim->bodies->n; ++b) {
+      const mpmc_body *B = &sim->bodies->b[b];
+      if (!(B->mu > 0.0)) continue;
+      for (int c = 0; c < 3; ++c) o[k++] = B->anchor ? B->anchor[3 * (size_t)q + c] : NAN;
+    }
+    pos[dest[q]] += (size_t)len;
   }
-  MPI_Irecv(in[0], (int)rlen[0], MPI_DOUBLE, lower(dd), TAG_MIGRATE, dd->comm, &req[0]);
-  MPI_Irecv(in[1], (int)rlen[1], MPI_DOUBLE, upper(dd), TAG_MIGRATE, dd->comm, &req[1]);
-  MPI_Isend(out[0], (int)slen[0], MPI_DOUBLE, lower(dd), TAG_MIGRATE, dd->comm, &req[2]);
-  MPI_Isend(out[1], (int)slen[1], MPI_DOUBLE, upper(dd), TAG_MIGRATE, dd->comm, &req[3]);
-  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, lower(dd), slen[0], sizeof(double));
-  count_sent(&dd->migrate_bytes, &dd->migrate_msgs, upper(dd), slen[1], sizeof(double));
-  MPI_Waitall(4, req, MPI_STATUSES_IGNORE);
+  if (!pos) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
+  free(pos);
+  err = mpmc_dd_agree(sim, err);
+  if (!err) exchange(dd, far, MPI_DOUBLE, sb, sc, sd, rb, rc, rd, TAG_MIGRATE);
 
   /* the staying points close ranks, in order; sets renumbered */
   int m = 0;
-  if (nout[0] || nout[1]) {
+  if (!err && nout) {
     int *map = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
     if (!map) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory");
-    for (int q = 0; q < n && map; ++q) map[q] = dest[q] ? -1 : m++;
+    for (int q = 0; q < n && map; ++q) map[q] = dest[q] != me ? -1 : m++;
     if (map) {
-      for (int i = 0; i < nf; ++i) {
-        if (!*f[i].a || f[i].nc <= 0) continue;
-        double *a = *f[i].a;
-        const size_t nc = (size_t)f[i].nc;
-        for (int q = 0; q < n; ++q)
-          if (map[q] >= 0 && map[q] != q) memcpy(a + (size_t)map[q] * nc, a + (size_t)q * nc, nc * sizeof(double));
-      }
+      for (int i = 0; i < nf; ++i)
+        if (*f[i].a && f[i].nc > 0) compact(*f[i].a, f[i].nc, map, n);
+      for (int b = 0; sim->bodies && b < sim->bodies->n; ++b)
+        if (sim->bodies->b[b].mu > 0.0 && sim->bodies->b[b].anchor)
+          compact(sim->bodies->b[b].anchor, 3, map, n);
       for (int q = 0; q < n; ++q)
         if (map[q] >= 0) {
           p->mat[map[q]] = p->mat[q];
@@ -652,15 +770,18 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
   } else {
     m = n;
   }
-  p->n = m;
-  /* the arrivals, the lower neighbour's first */
-  const int nin = hr[0][0] + hr[1][0];
+  if (!err) p->n = m;
+  /* the arrivals, in their senders' rank order */
   if (!err && nin > 0) {
     int cap = p->cap ? p->cap : 64;
     while (cap < m + nin) cap *= 2;
     err = mpmc_particles_reserve(ctx, p, cap);
+    unsigned any = 0;
+    for (int r = 0; r < P; ++r)
+      if (r != me && hr[(size_t)r * HDR] > 0) any |= (unsigned)hr[(size_t)r * HDR + 1];
     for (int i = 0; i < nf && !err; ++i)
-      if ((((unsigned)hr[0][1] | (unsigned)hr[1][1]) >> i & 1u)) err = ensure_field(sim, &f[i]);
+      if (any >> i & 1u) err = ensure_field(sim, &f[i]);
+    if (!err) err = reserve_anchors(sim, m + nin, 0);
     if (!err && !p->id) {
       p->id = malloc(sizeof(int) * (size_t)p->cap);
       if (!p->id) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory for the ids");
@@ -672,40 +793,29 @@ int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
       if (!idx) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "migration: no memory for the sets");
       else st->idx = idx;
     }
-    for (int s = 0; s < 2 && !err; ++s) {
-      const unsigned msk = (unsigned)hr[s][1];
-      const int rl = record_len(f, nf, msk, nsets);
-      for (int j = 0; j < hr[s][0]; ++j) {
-        const double *o = in[s] + (size_t)j * (size_t)rl;
-        const int q = p->n++;
-        int k = 0;
-        p->mat[q] = (int)o[k++];
-        p->id[q] = (int)o[k++];
-        for (int t = 0; t < nsets; ++t)
-          if (o[k++] != 0.0) {
-            mpmc_set *st = &sim->sets->s[t];
-            st->idx[st->n++] = q;
-          }
-        for (int i = 0; i < nf; ++i) {
-          if (!*f[i].a || f[i].nc <= 0) continue;
-          double *a = *f[i].a + (size_t)q * f[i].nc;
-          if (msk >> i & 1u) {
-            for (int c = 0; c < f[i].nc; ++c) a[c] = o[k++];
-          } else {
-            for (int c = 0; c < f[i].nc; ++c) a[c] = isnan(f[i].fill) ? (c < 3) : f[i].fill;
-          }
-        }
-      }
+    for (int r = 0; r < P && !err; ++r) {
+      const int *h = hr + (size_t)r * HDR;
+      if (r == me || h[0] <= 0) continue;
+      const unsigned msk = (unsigned)h[1];
+      const size_t rl = sender_len(f, nf, h);
+      for (int j = 0; j < h[0]; ++j)
+        unpack_point(sim, f, nf, msk, nsets, rb + rd[r] + (size_t)j * rl);
     }
   }
   free(dest);
+  free(ib);
   free(member);
   free(sb);
-  if (nin > 0 || nout[0] || nout[1]) {
+  if (nin > 0 || nout) {
     sim->order_ident = 0;
     sim->v2max_ok = 0; /* the stability limit takes its pass over v (stability.c) */
   }
   return mpmc_dd_agree(sim, err);
+}
+
+int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
+  if (!sim->dd || sim->dd->size == 1) return MPMC_SUCCESS;
+  return migrate(sim, 0);
 }
 
 #endif /* MPMC_HAVE_MPI */

@@ -603,6 +603,9 @@ void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n);
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n);
 /* 1 on the (lowest) rank whose v is the largest */
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v);
+/* the least v over the ranks and, of the ranks that have it, the least id (collective);
+ * without any: v = +inf and id = -1 */
+void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id);
 /* the number of ranks (1 in one process) */
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim);
 void mpmc_dd_free(struct mpmc_sim_s *sim);

@@ -58,7 +58,7 @@ static int step_phases(mpmc_sim sim, double dt, double *t) {
   if (sim->fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim, 1)); /* dF -> dF-bar (Alg. 1, 2-4)   */
   PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar);
                                    the built-in materials run F-bar's gather themselves */
-  if (sim->bodies) MPMC_CALL(mpmc_contact_check(sim)); /* no point inside a rigid body */
+  if (sim->bodies) PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_check(sim)); /* no point inside a body */
   PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_monitor_step(sim)); /* NaN velocity, energy growth */
   if (sim->dd) PHASE(sim, MPMC_PHASE_SORT, t, mpmc_dd_migrate(sim)); /* MPI: points to their slabs */
   return MPMC_SUCCESS;
@@ -76,8 +76,6 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   MPMC_CHECK(isfinite(dt) && dt > 0, ctx, MPMC_ERR_ARG, "time step dt = %g must be > 0", dt);
   MPMC_CHECK(sim->nmat > 0 && (sim->dd ? sim->np_global : sim->p.n) > 0, ctx, MPMC_ERR_STATE,
              "nothing to step: add a material and material points first");
-  MPMC_CHECK(!sim->dd || !sim->bodies, ctx, MPMC_ERR_UNSUPPORTED,
-             "rigid bodies are not supported over MPI yet (issue 47)");
   MPMC_CALL(mpmc_sim_prepare(sim));
 #ifdef _OPENMP
   const int saved = omp_get_max_threads();
