@@ -29,28 +29,8 @@
 #include <time.h>
 
 #include "mpmc.h"
-#include "mpmc_impl.h"
+#include "mpmc_bench.h" /* bytes per point (libmpmc/src, the internal archive) */
 
-/* bytes per point held by the particle store (fields allocated for this scene, the step's
- * scratch and the slab order; the grid excluded) */
-static double bytes_per_point(const mpmc_sim sim) {
-  const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
-  struct {
-    const void *a;
-    int n;
-  } f[] = {{p->x, d},          {p->x0, d},      {p->v, d},       {p->m, 1},
-           {p->vol0, 1},       {p->J, 1},       {p->stress, 6},  {p->Jbar, 1},
-           {p->be, 6},         {p->eps_p, 1},   {p->lp, 1},      {p->force, d},
-           {p->cforce, d},     {p->ustate, p->nustate},          {p->dF, d * d},
-           {p->xn, d},         {p->xoff, d},    {p->Janc, 1}};
-  double b = sizeof(int) * (p->id ? 3.0 : 2.0); /* material id, slab order, point id (sort) */
-  if (p->xnode) b += sizeof(int); /* F-bar's kept first nodes (transfer.h) */
-  if (sim->fb_scale) b += sizeof(double); /* F-bar's deferred factors (stress_j2.c) */
-  for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
-    if (f[i].a) b += sizeof(double) * (double)f[i].n;
-  return b;
-}
 static double last_bytes;
 static int shuffle_points, sort_every, use_cpu_time;
 static double last_phase[MPMC_PHASE_COUNT]; /* the last run's share of the step per phase */
@@ -99,17 +79,21 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
     CHECK(mpmc_sim_add_material_hencky(sim, 10e6, 0.3, 2000, &mat));
   CHECK(mpmc_sim_seed_box(sim, blo, bhi, 2, mat, NULL, np));
   if (shuffle_points) { /* every other field is still uniform: permuting x and x0 suffices */
-    mpmc_particles *p = &sim->p;
+    double *x, *x0;
+    CHECK(mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL));
+    CHECK(mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL));
     srand(12345);
     for (int q = *np - 1; q > 0; --q) {
       const int r = (int)(((double)rand() / ((double)RAND_MAX + 1.0)) * (q + 1));
       for (int a = 0; a < 3; ++a) {
-        double t = p->x[3 * q + a];
-        p->x[3 * q + a] = p->x[3 * r + a], p->x[3 * r + a] = t;
-        t = p->x0[3 * q + a];
-        p->x0[3 * q + a] = p->x0[3 * r + a], p->x0[3 * r + a] = t;
+        double t = x[3 * q + a];
+        x[3 * q + a] = x[3 * r + a], x[3 * r + a] = t;
+        t = x0[3 * q + a];
+        x0[3 * q + a] = x0[3 * r + a], x0[3 * r + a] = t;
       }
     }
+    CHECK(mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, &x));
+    CHECK(mpmc_sim_restore_field(sim, MPMC_FIELD_X0, &x0));
   }
   CHECK(mpmc_sim_set_sort_interval(sim, sort_every));
   if (scene == 1) {
@@ -135,7 +119,7 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
     last_phase_ms[k] = 1e3 * (st1.phase_seconds[k] - st0.phase_seconds[k]) / steps;
   }
   last_phase_ms[MPMC_PHASE_COUNT] = 1e3 * (st1.wall_seconds - st0.wall_seconds) / steps;
-  last_bytes = bytes_per_point(sim);
+  last_bytes = mpmc_bench_bytes_per_point(sim);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   return (double)(*np) * steps / t;

@@ -1,0 +1,23 @@
+/* The benchmarks' view of a simulation's internals (mpmc_bench.h). */
+#include "mpmc_bench.h"
+#include "mpmc_impl.h"
+
+double mpmc_bench_bytes_per_point(mpmc_sim sim) {
+  if (!sim) return 0.0;
+  const mpmc_particles *p = &sim->p;
+  const int d = sim->dim;
+  const struct {
+    const void *a;
+    int n;
+  } f[] = {{p->x, d},      {p->x0, d},     {p->v, d},          {p->m, 1},      {p->vol0, 1},
+           {p->J, 1},      {p->stress, 6}, {p->Jbar, 1},       {p->Janc, 1},   {p->be, 6},
+           {p->eps_p, 1},  {p->region, 1}, {p->Jp, 1},         {p->pw, 1},     {p->lp, 1},
+           {p->force, d},  {p->cforce, d}, {p->ustate, p->nustate},            {p->dF, d * d},
+           {p->xn, d},     {p->xoff, d}};
+  double b = sizeof(int) * (p->id ? 3.0 : 2.0); /* material id, slab order, point id (sort) */
+  if (p->xnode) b += sizeof(int);               /* F-bar's kept first nodes (transfer.h) */
+  if (sim->fb_scale) b += sizeof(double);       /* F-bar's deferred factors (stress_j2.c) */
+  for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
+    if (f[i].a) b += sizeof(double) * (double)f[i].n;
+  return b;
+}
