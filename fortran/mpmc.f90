@@ -168,7 +168,8 @@ module mpmc
     mpmc_sim_set_water_table_plane, mpmc_sim_set_geostatic_stress
   ! MPI builds only (libmpmc/include/mpmc_mpi.h): comm is MPI's Fortran handle, the integer
   ! of the mpi module or mpi_f08's comm%MPI_VAL
-  public :: mpmc_sim_create_mpi_f, mpmc_sim_get_mpi_slab, mpmc_sim_get_mpi_traffic
+  public :: mpmc_sim_create_mpi_f, mpmc_sim_get_mpi_slab, mpmc_sim_get_mpi_traffic, &
+    mpmc_sim_set_mpi_balance, mpmc_sim_get_mpi_imbalance
   public :: mpmc_sim_add_material_neo_hookean, mpmc_sim_add_material_hencky, &
     mpmc_sim_add_material_hencky_j2, mpmc_sim_add_material_hencky_j2_su, &
     mpmc_sim_add_material_newtonian, mpmc_sim_get_num_materials, mpmc_sim_reduce_strength, &
@@ -323,6 +324,22 @@ module mpmc
       type(mpmc_sim), value :: sim
       real(c_double), intent(out) :: halo_bytes, migrated_bytes
       integer(c_long), intent(out) :: halo_msgs, migrate_msgs
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_mpi_balance(sim, every_n_steps, threshold) &
+        bind(C, name='mpmc_sim_set_mpi_balance') result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      integer(c_int), value :: every_n_steps
+      real(c_double), value :: threshold
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_get_mpi_imbalance(sim, imbalance, balances) &
+        bind(C, name='mpmc_sim_get_mpi_imbalance') result(ierr)
+      import :: c_int, c_long, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), intent(out) :: imbalance
+      integer(c_long), intent(out) :: balances
       integer(c_int) :: ierr
     end function
     function mpmc_sim_get_dim(sim, dim) bind(C, name='mpmc_sim_get_dim') result(ierr)

@@ -25,8 +25,13 @@
  * points) instead of one sum in the serial slab order (round-off, tests/mpi).
  *
  * Migration.  After each step a point whose cell left the slab moves, with every per-point
- * field, its material id, global id and particle-set membership, to the neighbour whose
- * slab it entered; a point that went further than a neighbour stops the run.
+ * field, its material id, global id, particle-set membership and friction anchors, to the
+ * neighbour whose slab it entered; a point that went further than a neighbour stops the run.
+ *
+ * Load balance (mpmc_sim_set_mpi_balance, off by default).  Before a step, when due, the
+ * ranks count the points per cell along the axis, place each cut where the points below it
+ * come nearest to its share (slabs of MPMC_DD_MIN_CELLS or more, cuts clear of mirrored
+ * walls, as check_mirrors requires), and every point goes to its new owner, any rank away.
  *
  * Failures.  Every phase of an MPI step ends with mpmc_dd_agree: a failure on any rank
  * becomes the same error code and message on every rank (the lowest failing rank's,
@@ -45,6 +50,7 @@
 int mpmc_dd_agree(struct mpmc_sim_s *sim, int err) { return (void)sim, err < 0 ? MPMC_SUCCESS : err; }
 int mpmc_dd_halo(struct mpmc_sim_s *sim, int what) { return (void)sim, (void)what, MPMC_SUCCESS; }
 int mpmc_dd_migrate(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
+int mpmc_dd_balance_due(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
 int mpmc_dd_setup(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
 int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) { return (void)sim, (void)x, 1; }
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
@@ -73,6 +79,12 @@ struct mpmc_dd_s {
    * the halo sums, and of migration (its counts and records; rebalancing's included) */
   double halo_bytes, migrate_bytes;
   long halo_msgs, migrate_msgs;
+  /* load balance (mpmc_sim_set_mpi_balance): every so many steps and/or beyond a max/mean
+   * points threshold (0: not); the step of the last balance; balances done */
+  int bal_every;
+  double bal_threshold;
+  long long bal_last;
+  long bal_count;
 };
 
 enum { TAG_HALO = 4701, TAG_MIGRATE_N = 4702, TAG_MIGRATE = 4703 };
@@ -816,6 +828,116 @@ static int migrate(struct mpmc_sim_s *sim, int far) {
 int mpmc_dd_migrate(struct mpmc_sim_s *sim) {
   if (!sim->dd || sim->dd->size == 1) return MPMC_SUCCESS;
   return migrate(sim, 0);
+}
+
+/* ---- load balance --------------------------------------------------------------------- */
+
+/** @brief Move the cuts every every_n_steps steps and/or when max/mean points exceeds
+ *         threshold (mpmc_mpi.h); 0 and 0: fixed slabs (the default). */
+int mpmc_sim_set_mpi_balance(mpmc_sim sim, int every_n_steps, double threshold) {
+  if (!sim) return MPMC_ERR_ARG;
+  struct mpmc_dd_s *dd = sim->dd;
+  MPMC_CHECK(dd, sim->ctx, MPMC_ERR_STATE, "not a simulation of mpmc_sim_create_mpi");
+  MPMC_CHECK(every_n_steps >= 0, sim->ctx, MPMC_ERR_ARG,
+             "every_n_steps = %d must be >= 0 (0: no periodic balance)", every_n_steps);
+  MPMC_CHECK(threshold == 0 || (isfinite(threshold) && threshold >= 1), sim->ctx, MPMC_ERR_ARG,
+             "threshold = %g must be 0 (none) or >= 1 (the most points on a rank over the mean)",
+             threshold);
+  dd->bal_every = every_n_steps;
+  dd->bal_threshold = threshold;
+  dd->bal_last = sim->stats.steps;
+  return MPMC_SUCCESS;
+}
+
+/* The most points on a rank over the mean (1: even; collective). */
+static double imbalance(const struct mpmc_sim_s *sim) {
+  long long n = sim->p.n, mx = 0, sum = 0;
+  MPI_Allreduce(&n, &mx, 1, MPI_LONG_LONG, MPI_MAX, sim->dd->comm);
+  MPI_Allreduce(&n, &sum, 1, MPI_LONG_LONG, MPI_SUM, sim->dd->comm);
+  return sum > 0 ? (double)mx * sim->dd->size / (double)sum : 1.0;
+}
+
+/** @brief The most points on a rank over the mean over the ranks (collective; mpmc_mpi.h). */
+int mpmc_sim_get_mpi_imbalance(const mpmc_sim sim, double *value, long *balances) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(sim->dd, sim->ctx, MPMC_ERR_STATE, "not a simulation of mpmc_sim_create_mpi");
+  if (value) *value = imbalance(sim);
+  if (balances) *balances = sim->dd->bal_count;
+  return MPMC_SUCCESS;
+}
+
+/* Cut c moved out of the reach of the walls mirrored along the slab axis (check_mirrors:
+ * planes within MPMC_GHOST + 2 of a cut), to the nearer allowed side within [lo, hi];
+ * -1 if there is none. */
+static int clear_of_mirrors(const struct mpmc_sim_s *sim, int c, int lo, int hi) {
+  const int reach = MPMC_GHOST + 2;
+  for (int pass = 0; pass <= sim->nmirror; ++pass) {
+    int moved = 0;
+    for (int w = 0; w < sim->nmirror; ++w) {
+      const mpmc_mirror *m = &sim->mirrors[w];
+      if (m->axis != sim->dd->axis || c < m->plane - reach || c > m->plane + reach) continue;
+      const int below = m->plane - reach - 1, above = m->plane + reach + 1;
+      const int okb = below >= lo && below <= hi, oka = above >= lo && above <= hi;
+      if (!okb && !oka) return -1;
+      c = okb && (!oka || c - below <= above - c) ? below : above;
+      moved = 1;
+    }
+    if (!moved) return c;
+  }
+  return -1;
+}
+
+/* New cuts that split the points evenly (whole cells, slabs of MPMC_DD_MIN_CELLS or more,
+ * clear of mirrored walls), then every point to its new owner (collective). */
+static int balance(struct mpmc_sim_s *sim) {
+  struct mpmc_dd_s *dd = sim->dd;
+  const int P = dd->size, cells = dd->cut[P];
+  if (sim->walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim)); /* the mirrors */
+  long long *cum = calloc((size_t)cells + 1, sizeof *cum);
+  int *nc = malloc(sizeof(int) * (size_t)(P + 1));
+  int err = cum && nc ? MPMC_SUCCESS : MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "balance: no memory");
+  err = mpmc_dd_agree(sim, err);
+  if (err) {
+    free(cum);
+    free(nc);
+    return err;
+  }
+  for (int q = 0; q < sim->p.n; ++q) cum[1 + slab_cell(sim, sim->p.x + (size_t)q * sim->dim)]++;
+  MPI_Allreduce(MPI_IN_PLACE, cum + 1, cells, MPI_LONG_LONG, MPI_SUM, dd->comm);
+  for (int c = 1; c <= cells; ++c) cum[c] += cum[c - 1]; /* cum[c]: points in cells < c */
+  nc[0] = 0;
+  nc[P] = cells;
+  int ok = 1;
+  for (int r = 1; r < P && ok; ++r) {
+    const double target = (double)cum[cells] * r / P;
+    const int lo = nc[r - 1] + MPMC_DD_MIN_CELLS, hi = cells - MPMC_DD_MIN_CELLS * (P - r);
+    int c = lo;
+    while (c < hi && (double)cum[c + 1] <= target) ++c;
+    if (c < hi && target - (double)cum[c] > (double)cum[c + 1] - target) ++c;
+    c = clear_of_mirrors(sim, c, lo, hi);
+    ok = c >= 0;
+    nc[r] = c;
+  }
+  int same = 1;
+  for (int r = 0; r <= P && ok; ++r) same &= nc[r] == dd->cut[r];
+  free(cum);
+  if (ok && !same) memcpy(dd->cut, nc, sizeof(int) * (size_t)(P + 1));
+  free(nc);
+  if (!ok || same) return MPMC_SUCCESS; /* no better cuts (or none the walls allow) */
+  dd->bal_count++;
+  return migrate(sim, 1);
+}
+
+/* Before a step: balance if due (mpmc_sim_set_mpi_balance; collective). */
+int mpmc_dd_balance_due(struct mpmc_sim_s *sim) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!dd || dd->size == 1 || dd->axis < 0 || (!dd->bal_every && !(dd->bal_threshold > 0)))
+    return MPMC_SUCCESS;
+  int due = dd->bal_every > 0 && sim->stats.steps - dd->bal_last >= dd->bal_every;
+  if (!due && dd->bal_threshold > 0) due = imbalance(sim) > dd->bal_threshold;
+  if (!due) return MPMC_SUCCESS;
+  dd->bal_last = sim->stats.steps;
+  return balance(sim);
 }
 
 #endif /* MPMC_HAVE_MPI */

@@ -598,6 +598,8 @@ int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x);
 int mpmc_dd_agree(struct mpmc_sim_s *sim, int err);
 int mpmc_dd_halo(struct mpmc_sim_s *sim, int what);
 int mpmc_dd_migrate(struct mpmc_sim_s *sim);
+/* before a step: move the cuts and the points if a balance is due (collective) */
+int mpmc_dd_balance_due(struct mpmc_sim_s *sim);
 /* v[0 .. n) summed over the ranks in rank order (the same bits on every rank) / maximum */
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n);
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n);

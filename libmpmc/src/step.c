@@ -94,6 +94,8 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
                        dt, limit, sim->grid.h, limit);
   }
   lap(sim, MPMC_PHASE_CHECKS, &t);
+  if (sim->dd) err = mpmc_dd_agree(sim, err);
+  if (!err && sim->dd) err = mpmc_dd_balance_due(sim); /* MPI: cuts moved to even the points */
   if (!err) err = mpmc_sort_due(sim); /* locality: points by cell (sort.c), if asked for */
   if (sim->dd) err = mpmc_dd_agree(sim, err);
   lap(sim, MPMC_PHASE_SORT, &t);
