@@ -32,7 +32,8 @@
 
 #define FOS_CHECK_EVERY 20 /* steps between displacement checks (a trial stops when it fails) */
 
-/* largest |x - xs[id]| over the points (xs by point id: the sort moves points) */
+/* largest |x - xs[id]| over the points (xs by point id: the sort moves points); over MPI
+ * the largest over the ranks (each its own points) */
 static double max_displacement(mpmc_sim sim, int dim, const double *xs) {
   double *x;
   const int *ids;
@@ -49,14 +50,14 @@ static double max_displacement(mpmc_sim sim, int dim, const double *xs) {
     }
     if (d2 > m) m = d2;
   }
-  return sqrt(m);
+  return sqrt(wf_par_max(m));
 }
 
 /* the base state with the strengths divided by F, in *sim; its positions by id in *xs */
 static int open_trial(mpmc_context ctx, const char *base, const wf_scene *sc, double F, mpmc_sim *sim,
                       double **xs) {
   char *meta = NULL;
-  int e = mpmc_sim_checkpoint_read(ctx, base, sim, &meta);
+  int e = wf_par_checkpoint_read(ctx, base, sim, &meta);
   mpmc_free(meta);
   if (e) return e;
   if (!e) e = mpmc_sim_set_threads(*sim, sc->threads);
@@ -65,9 +66,9 @@ static int open_trial(mpmc_context ctx, const char *base, const wf_scene *sc, do
   int n = 0;
   double *x;
   const int *ids;
-  if (!e) e = mpmc_sim_get_num_particles(*sim, &n);
-  if (!e) e = mpmc_sim_get_field(*sim, MPMC_FIELD_POSITION, &x, NULL);
-  if (!e) e = mpmc_sim_get_particle_ids(*sim, &ids);
+  if (!e) e = wf_all_count(*sim, &n); /* over MPI: every rank's points */
+  if (!e) e = wf_all_field(*sim, MPMC_FIELD_POSITION, &x, NULL);
+  if (!e) e = wf_all_ids(*sim, &ids);
   if (!e && xs) {
     *xs = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1) * (size_t)sc->dim);
     if (!*xs) e = MPMC_ERR_MEMORY;
@@ -235,7 +236,8 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
                   size_t len) {
   const wf_stage *s = &sc->stages[stage];
   const wf_fos *f = &s->fos;
-  const int jobs = wf_fos_jobs(f);
+  /* over MPI the trials run one after the other, each over all the ranks */
+  const int jobs = wf_par_size() > 1 ? 1 : wf_fos_jobs(f);
   char base[WF_PATH + 32], path[WF_PATH + 32], line[512];
   if (jobs > 1 && sc->threads != 1) {
     /* OpenMP's thread pool does not survive a fork; one thread per trial process anyway */
@@ -245,7 +247,7 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
   }
   /* this search's pictures, not an earlier run's */
   static const char *const old[] = {"fos_mechanism.csv", "fos_mechanism.png", "fos_trials.png", NULL};
-  for (int i = 0; old[i]; ++i) {
+  for (int i = 0; old[i] && wf_par_rank() == 0; ++i) {
     snprintf(path, sizeof path, "%s/%s", outdir, old[i]);
     remove(path);
   }
@@ -283,7 +285,7 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
     const int first = res->ntrial + 1;
     e = run_round(ctx, base, sc, s, outdir, F, k, first, t, msg, len);
     if (e) {
-      for (int j = 0; j < k; ++j) {
+      for (int j = 0; j < k && wf_par_rank() == 0; ++j) {
         mech_path(path, sizeof path, outdir, first + j);
         remove(path);
       }
@@ -327,7 +329,7 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
     /* the mechanism: the final state of the trial at the smallest failing factor */
     char mech[WF_PATH + 32];
     snprintf(path, sizeof path, "%s/fos_mechanism.csv", outdir);
-    for (int j = 0; j < k; ++j) {
+    for (int j = 0; j < k && wf_par_rank() == 0; ++j) { /* rank 0 wrote them */
       mech_path(mech, sizeof mech, outdir, first + j);
       if (j == hi_from) {
         res->mechanism = rename(mech, path) == 0;
@@ -336,6 +338,7 @@ int wf_fos_search(mpmc_context ctx, mpmc_sim sim, const wf_scene *sc, int stage,
         remove(mech);
       }
     }
+    res->mechanism = wf_par_total(wf_par_rank() == 0 && res->mechanism) > 0;
   }
   res->lo = lo;
   res->hi = hi;

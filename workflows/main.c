@@ -6,6 +6,15 @@
 
 #include "mpmc.h"
 #include "mpmc_workflow.h"
+#ifdef MPMC_HAVE_MPI
+#include <mpi.h>
+
+/* Started by an MPI launcher (mpirun/mpiexec of OpenMPI, or a PMI/PMIx one): the run is one
+ * simulation over MPI_COMM_WORLD (docs/mpi.md); run plainly, MPI is not started at all. */
+static int launched(void) {
+  return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_SIZE") || getenv("PMIX_RANK");
+}
+#endif
 
 static const char usage[] =
     "usage: mpmc run SCENE.yaml [--out DIR] [--set key.path=value ...] [--threads N] [--force] [--quiet]\n"
@@ -158,6 +167,15 @@ int main(int argc, char **argv) {
             out ? "--out" : "--force", target, usage);
     return 2;
   }
+  int rank = 0, mpi = 0;
+#ifdef MPMC_HAVE_MPI
+  if (launched()) { /* OpenMP threads inside each rank; MPI called from the main thread */
+    int provided;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    mpi = 1;
+  }
+#endif
   mpmc_context ctx;
   if (mpmc_context_create(&ctx)) return 1;
   int err;
@@ -167,8 +185,12 @@ int main(int argc, char **argv) {
     err = mpmc_workflow_run(ctx, target, out, nset, sets,
                             flags | (!strcmp(cmd, "check") ? MPMC_WORKFLOW_CHECK : 0) |
                                 (!strcmp(cmd, "fos") ? MPMC_WORKFLOW_FOS : 0));
-  if (err) print_error(ctx, err);
+  if (err && rank == 0) print_error(ctx, err); /* over MPI every rank has the error: rank 0 says it */
   mpmc_context_destroy(&ctx);
+#ifdef MPMC_HAVE_MPI
+  if (mpi) MPI_Finalize();
+#endif
+  (void)mpi;
   for (int i = 0; i < nowned; ++i) free(owned[i]);
   free(owned);
   free(sets);

@@ -56,20 +56,21 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
   int np = 0;
   double *x, *x0 = NULL, *sig, *eps = NULL;
   const int *ids = NULL;
-  if (mpmc_sim_get_num_particles(sim, &np) || mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
-      (xs ? mpmc_sim_get_particle_ids(sim, &ids) : mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
-      mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
+  if (wf_all_count(sim, &np) || wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
+      (xs ? wf_all_ids(sim, &ids) : wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
+      wf_all_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
     return -1;
   int plastic = 0;
   for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
-  if (plastic && mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
+  if (plastic && wf_all_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
   *has_eps = eps != NULL;
   /* the return region of the frictional models (docs/materials.md), last column */
   double *region = NULL;
-  if (mpmc_sim_get_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
+  if (wf_all_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
   /* the water table's pore pressure, after it */
   double *pw = NULL;
-  if ((!sc->water.n && !sc->water.has_plane) || mpmc_sim_get_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
+  if ((!sc->water.n && !sc->water.has_plane) || wf_all_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
+  if (wf_par_rank() != 0) return 0; /* over MPI: rank 0 writes (all ranks gathered) */
   const int d = sc->dim;
   wf_depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
   FILE *f = fopen(path, "w");
@@ -173,6 +174,7 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
     snprintf(warn, len, "cannot write %s", path);
     return 1;
   }
+  if (wf_par_rank() != 0) return 0;
   FILE *g = wf_gnuplot_open(outdir, "plots.log", "plots",
                             "no PNG plots, the data is in final_state.csv and series.csv", warn, len);
   if (!g) return 1;

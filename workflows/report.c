@@ -15,6 +15,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "wf.h"
 
 const char *const wf_metric_names[WF_METRIC_COUNT] = {"runout_distance", "tip_displacement_y",
@@ -38,9 +42,9 @@ static double hydro_error(mpmc_sim sim, const wf_scene *sc) {
   const wf_metrics *m = &sc->metrics;
   double *x, *mass, *vol0, *sig;
   int np;
-  mpmc_sim_get_num_particles(sim, &np);
-  if (mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) || mpmc_sim_get_field(sim, MPMC_FIELD_MASS, &mass, NULL) ||
-      mpmc_sim_get_field(sim, MPMC_FIELD_VOLUME0, &vol0, NULL) || mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
+  wf_all_count(sim, &np);
+  if (wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL) || wf_all_field(sim, MPMC_FIELD_MASS, &mass, NULL) ||
+      wf_all_field(sim, MPMC_FIELD_VOLUME0, &vol0, NULL) || wf_all_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
     return NAN;
   double num = 0, den = 0;
   for (int q = 0; q < np; ++q) {
@@ -69,11 +73,11 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
   const wf_metrics *m = &sc->metrics;
   double *x0;
   int np, e;
-  mpmc_sim_get_num_particles(sim, &np);
-  if ((e = mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL))) return e;
+  wf_all_count(sim, &np);
+  if ((e = wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL))) return e;
   const int d = sc->dim;
   const int *mat = NULL; /* the points of the run-out's material only, when it names one */
-  if (m->enabled[WF_METRIC_RUNOUT] && m->runout_material >= 0 && (e = mpmc_sim_get_material_ids(sim, &mat)))
+  if (m->enabled[WF_METRIC_RUNOUT] && m->runout_material >= 0 && (e = wf_all_materials(sim, &mat)))
     return e;
   const int slide = m->runout_material >= 0 ? sc->mats[m->runout_material].id : -1;
   if (m->enabled[WF_METRIC_RUNOUT] && !m->has_toe) {
@@ -85,7 +89,7 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
   if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {
     /* by id: the sort by cell (sort_interval) moves the point to other indices */
     const int *ids;
-    if ((e = mpmc_sim_get_particle_ids(sim, &ids))) return e;
+    if ((e = wf_all_ids(sim, &ids))) return e;
     double best = INFINITY;
     for (int q = 0; q < np; ++q) {
       double r2 = 0;
@@ -103,15 +107,15 @@ static int metrics_of_fields(mpmc_sim sim, const wf_scene *sc, double *v) {
   const wf_metrics *m = &sc->metrics;
   double *x, *x0, *mass;
   int np, e;
-  mpmc_sim_get_num_particles(sim, &np);
-  if ((e = mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL))) return e;
-  if ((e = mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL))) return e;
-  if ((e = mpmc_sim_get_field(sim, MPMC_FIELD_MASS, &mass, NULL))) return e;
+  wf_all_count(sim, &np);
+  if ((e = wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL))) return e;
+  if ((e = wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL))) return e;
+  if ((e = wf_all_field(sim, MPMC_FIELD_MASS, &mass, NULL))) return e;
   const int d = sc->dim;
   for (int k = 0; k < WF_METRIC_COUNT; ++k) v[k] = NAN;
   if (m->enabled[WF_METRIC_RUNOUT]) {
     const int *mat = NULL;
-    if (m->runout_material >= 0 && (e = mpmc_sim_get_material_ids(sim, &mat))) return e;
+    if (m->runout_material >= 0 && (e = wf_all_materials(sim, &mat))) return e;
     const int slide = m->runout_material >= 0 ? sc->mats[m->runout_material].id : -1;
     double front = -INFINITY;
     for (int q = 0; q < np; ++q)
@@ -120,7 +124,7 @@ static int metrics_of_fields(mpmc_sim sim, const wf_scene *sc, double *v) {
   }
   if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {
     const int *ids;
-    if ((e = mpmc_sim_get_particle_ids(sim, &ids))) return e;
+    if ((e = wf_all_ids(sim, &ids))) return e;
     size_t q = 0;
     while ((int)q < np - 1 && ids[q] != m->tip_id) ++q;
     v[WF_METRIC_TIP_X] = x[q * d] - x0[q * d];
@@ -181,8 +185,8 @@ int wf_series_row(FILE *f, mpmc_sim sim, const wf_scene *sc, int stage, long ste
                   double ratio) {
   double t, m[WF_METRIC_COUNT];
   mpmc_sim_get_time(sim, &t);
-  const int e = wf_metrics_compute(sim, sc, m);
-  if (e) return e;
+  const int e = wf_metrics_compute(sim, sc, m); /* over MPI on every rank (collective) */
+  if (e || !f) return e;                        /* f: rank 0's */
   fprintf(f, "%s,%.9g,%ld,%.6g,%.9g,%.6g", sc->stages[stage].name, t, step, dt, ke, ratio);
   /* a metric not defined yet (the footing's ratio before its first step) is an empty field,
      never a NaN; + 0.0 turns -0 into 0 */
@@ -270,14 +274,20 @@ static double jnum(double v) { return isfinite(v) ? v : 0.0; }
 void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const char *error,
                       const wf_stage_record *rec, int nstages_done, double wall, const wf_fos_result *fos) {
   const int ok = error == NULL;
-  FILE *f = fopen(path, "w");
-  if (!f) return;
   mpmc_stats st = {0};
   int np = 0;
-  if (sim) {
+  double m[WF_METRIC_COUNT] = {0};
+  int have_m = 0;
+  if (sim) { /* over MPI: collective, every rank's points and counts */
     mpmc_sim_get_stats(sim, &st);
-    mpmc_sim_get_num_particles(sim, &np);
+    wf_all_count(sim, &np);
+    st.particle_steps = wf_par_total(st.particle_steps);
+    st.return_maps = wf_par_total(st.return_maps);
+    st.kinsol_fallbacks = wf_par_total(st.kinsol_fallbacks);
+    have_m = np > 0 && wf_metrics_compute(sim, sc, m) == 0;
   }
+  FILE *f = wf_par_rank() == 0 ? fopen(path, "w") : NULL; /* rank 0 writes */
+  if (!f) return;
   fputs("{\n  \"scene\": ", f);
   json_str(f, sc->name);
   fputs(",\n  \"scene_file\": ", f);
@@ -300,6 +310,11 @@ void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const 
   int sort_every = 0;
   mpmc_sim_get_sort_interval(sim, &sort_every);
   fprintf(f, "  \"sort_interval\": %d,\n", sort_every);
+  int threads = 1;
+#ifdef _OPENMP
+  threads = sc->threads > 0 ? sc->threads : omp_get_max_threads();
+#endif
+  fprintf(f, "  \"ranks\": %d,\n  \"threads_per_rank\": %d,\n", wf_par_size(), threads);
   fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
   fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
           st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);
@@ -321,8 +336,7 @@ void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const 
   }
   fputs(nstages_done ? "\n  ]" : "]", f);
   if (fos && fos->ntrial > 0) wf_fos_json(f, fos);
-  double m[WF_METRIC_COUNT] = {0};
-  if (sim && np > 0 && wf_metrics_compute(sim, sc, m) == 0)
+  if (have_m)
     for (int k = 0; k < WF_METRIC_COUNT; ++k)
       /* all 17 digits: the Fortran example is compared with the front end to 1e-9 relative */
       if (sc->metrics.enabled[k]) fprintf(f, ",\n  \"%s\": %.17g", wf_metric_names[k], jnum(m[k]));
@@ -360,6 +374,7 @@ static void fmt_eta(double s, char *buf, size_t len) {
  */
 void wf_progress_update(wf_progress *p, const wf_scene *sc, int stage, double t_stage, double t_end,
                         long steps, double rate, double interval, int force) {
+  if (wf_par_rank() != 0) return; /* over MPI: rank 0's */
   const double now = wf_now();
   const double every = p->tty ? 0.2 : interval;
   if (!force && now - p->last_print < every) return;
@@ -392,6 +407,6 @@ void wf_progress_update(wf_progress *p, const wf_scene *sc, int stage, double t_
 }
 
 void wf_progress_done(wf_progress *p) {
-  if (p->tty) fputc('\n', stderr);
+  if (p->tty && wf_par_rank() == 0) fputc('\n', stderr);
   p->last_print = -1e300;
 }

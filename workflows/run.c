@@ -92,7 +92,7 @@ static void set_threads(wf_run *w) {
 
 static void say(const wf_run *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void say(const wf_run *w, const char *fmt, ...) {
-  if (w->quiet) return;
+  if (w->quiet || wf_par_rank() != 0) return; /* over MPI: rank 0's log */
   va_list ap;
   va_start(ap, fmt);
   fputs("mpmc: ", stdout);
@@ -210,7 +210,7 @@ static int remove_old_outputs(wf_run *w) {
 /* ---- set-up ---------------------------------------------------------------------------- */
 static int build(wf_run *w) {
   wf_scene *sc = &w->sc;
-  WF_TRY(w, mpmc_sim_create(w->ctx, sc->dim, &w->sim), "creating the simulation");
+  WF_TRY(w, wf_par_sim_create(w->ctx, sc->dim, &w->sim), "creating the simulation"); /* par.c */
   mpmc_sim sim = w->sim;
   WF_TRY(w, mpmc_sim_set_grid(sim, sc->lo, sc->hi, sc->h), "grid");
   WF_TRY(w, mpmc_sim_set_basis(sim, sc->basis), "basis");
@@ -250,8 +250,10 @@ static int build(wf_run *w) {
     for (int a = 0; a < sc->dim; ++a) nonzero |= b->velocity[a] != 0.0;
     if (nonzero) {
       double *v;
+      int upto = 0; /* the body's points: [first, upto) (over MPI this rank's of its count) */
+      mpmc_sim_get_num_particles(sim, &upto);
       WF_TRY(w, mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL), "velocity");
-      for (int q = first; q < first + count; ++q)
+      for (int q = first; q < upto; ++q)
         for (int a = 0; a < sc->dim; ++a) v[(size_t)q * sc->dim + a] = b->velocity[a];
       mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v);
     }
@@ -276,7 +278,7 @@ static const char *kernels_detail(int k) {
 static void log_plan(const wf_run *w) {
   const wf_scene *sc = &w->sc;
   int np = 0, plastic = 0, gmsh = 0, damping = 0, tractions = 0, walls = 0, srf = 0;
-  if (w->sim) mpmc_sim_get_num_particles(w->sim, &np);
+  if (w->sim) wf_all_count(w->sim, &np);
   for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
   for (int i = 0; i < sc->nbody; ++i) gmsh |= sc->bodies[i].type == WF_GEOM_GMSH;
   for (int i = 0; i < sc->nstage; ++i) {
@@ -304,6 +306,7 @@ static void log_plan(const wf_run *w) {
   FEATURE(srf, "strength reduction");
   FEATURE(sc->nrigid > 0, "rigid-body contact");
   FEATURE(sc->sort_interval > 0, "sorting by cell (sort_interval)");
+  FEATURE(wf_par_size() > 1, "MPI (points and grid over the ranks)");
 #ifdef MPMC_WF_HAVE_CHECKPOINT
   FEATURE(1, "checkpoints");
 #else
@@ -315,6 +318,9 @@ static void log_plan(const wf_run *w) {
   int kern = MPMC_KERNELS_BASELINE;
   if (w->sim) mpmc_sim_get_kernels(w->sim, &kern);
   say(w, "kernels: %s", kernels_detail(kern));
+  char mpi[256] = "";
+  if (w->sim) wf_par_plan(w->sim, mpi, sizeof mpi);
+  if (mpi[0]) say(w, "%s", mpi);
   for (int i = 0; i < sc->nmat; ++i) {
     const wf_material *m = &sc->mats[i];
     char line[512];
@@ -425,7 +431,7 @@ static int stage_setup(wf_run *w, int i) {
           for (int a = 0; a < d; ++a) f[(size_t)q * d + a] += t->traction[a] * pow(vol0[q], expo);
         }
       }
-      if (!e && hits == 0) {
+      if (!e && wf_par_total(hits) == 0) { /* over MPI: on any rank */
         free(f);
         return fail(w, MPMC_ERR_ARG, "stages.%d.tractions.%d: no material point in the set or region", i, k);
       }
@@ -455,7 +461,8 @@ static int stage_setup(wf_run *w, int i) {
 
 /* A row of series.csv (report.c); a failure stops the run with the reason. */
 static int series_row(wf_run *w, int stage, long step, double dt, double ke, double ratio) {
-  const int e = wf_series_row(w->series, w->sim, &w->sc, stage, step, dt, ke, ratio);
+  /* over MPI every rank computes the metrics, rank 0 writes the row */
+  const int e = wf_par_agree(wf_series_row(w->series, w->sim, &w->sc, stage, step, dt, ke, ratio));
   if (e == MPMC_ERR_IO) return fail(w, e, "cannot write %s/series.csv: %s", w->out, strerror(errno));
   WF_TRY(w, e, "metrics");
   return 0;
@@ -482,6 +489,7 @@ static int checkpoint(wf_run *w, int stage, const wf_clock *c, long steps) {
   /* the absolute path, so that `mpmc resume` works from any directory */
   if (!realpath(w->sc.path, r.scene)) snprintf(r.scene, sizeof r.scene, "%s", w->sc.path);
   if (wf_record_format(&r, meta, sizeof meta)) return fail(w, MPMC_ERR_MEMORY, "checkpoint: too many overrides to record");
+  wf_par_share(meta, (int)sizeof meta); /* over MPI: rank 0's record (its wall seconds) on every rank */
   WF_TRY(w, mpmc_sim_checkpoint_write(w->sim, path, meta), "checkpoint %s", path);
   w->ckpt_ok = 1;
   mpmc_sim_get_time(w->sim, &w->ckpt_time);
@@ -645,14 +653,17 @@ static int run_fos(wf_run *w, int i) {
   char msg[WF_MSG] = "";
   say(w, "stage %d/%d %s: factor of safety between %g and %g to %g, trials of %g s, failure beyond %g m, "
       "%d trial%s at once", i + 1, w->sc.nstage, s->name, s->fos.lo, s->fos.hi, s->fos.tolerance, s->end_time,
-      s->fos.displacement_limit, s->fos.jobs, s->fos.jobs > 1 ? "s (child processes)" : "");
+      s->fos.displacement_limit, wf_par_size() > 1 ? 1 : s->fos.jobs,
+      wf_par_size() > 1 ? (s->fos.jobs > 1 ? " (over MPI: one at a time over the ranks)" : "")
+      : s->fos.jobs > 1 ? "s (child processes)" : "");
   const int e = wf_fos_search(w->ctx, w->sim, &w->sc, i, w->out, w->fos, w->quiet ? NULL : say_line, w, msg,
                               sizeof msg);
   if (e) return fail(w, e, "stage '%s': %s", s->name, msg);
   char path[WF_PATH];
   out_path(w, "fos_trials.csv", path, sizeof path);
-  if (wf_fos_write_csv(path, w->fos)) return fail(w, MPMC_ERR_IO, "cannot write %s: %s", path, strerror(errno));
-  if (w->sc.plots) {
+  if (wf_par_agree(wf_par_rank() == 0 && wf_fos_write_csv(path, w->fos) ? MPMC_ERR_IO : 0))
+    return fail(w, MPMC_ERR_IO, "cannot write %s: %s", path, strerror(errno));
+  if (w->sc.plots && wf_par_rank() == 0) {
     char warn[WF_MSG] = "";
     if (wf_fos_plots(&w->sc, i, w->fos, w->out, warn, sizeof warn)) say(w, "warning: plots: %s", warn);
   }
@@ -674,7 +685,9 @@ static int run_fos(wf_run *w, int i) {
 static int open_outputs(wf_run *w, int append) {
   char path[WF_PATH], xpath[WF_PATH], msg[WF_MSG];
   out_path(w, "series.csv", path, sizeof path);
-  if (!(w->series = wf_series_open(path, &w->sc, append, msg, sizeof msg))) return fail(w, MPMC_ERR_IO, "%s", msg);
+  msg[0] = '\0';
+  if (wf_par_rank() == 0) w->series = wf_series_open(path, &w->sc, append, msg, sizeof msg); /* rank 0's */
+  if (wf_par_agree(wf_par_rank() == 0 && !w->series ? MPMC_ERR_IO : 0)) return fail(w, MPMC_ERR_IO, "%s", msg);
   w->resumed = append;
   out_path(w, append ? "snapshots_resumed.h5" : "snapshots.h5", path, sizeof path);
   out_path(w, append ? "snapshots_resumed.xdmf" : "snapshots.xdmf", xpath, sizeof xpath);
@@ -732,7 +745,8 @@ static int finish(wf_run *w, int err) {
     if (err == 0 && w->sc.plots && w->sim) {
       char warn[WF_MSG] = "";
       if (wf_plots_write(w->sim, &w->sc, w->out, warn, sizeof warn)) say(w, "warning: plots: %s", warn);
-      if (wf_snapplots_plot(&w->sc, w->out, warn, sizeof warn)) say(w, "warning: snapshot plots: %s", warn);
+      if (wf_par_rank() == 0 && wf_snapplots_plot(&w->sc, w->out, warn, sizeof warn))
+        say(w, "warning: snapshot plots: %s", warn);
     }
     if (err == 0) say(w, "done in %.1f s: %s", wf_now() - w->t_start, path);
   }
@@ -742,6 +756,7 @@ static int finish(wf_run *w, int err) {
 #endif
   mpmc_output_destroy(&w->snap);
   mpmc_sim_destroy(&w->sim);
+  wf_all_release();
   free(w->rec);
   free(w->fos);
   free(w->wall_ids);
@@ -792,7 +807,7 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
   else
     snprintf(w.out, sizeof w.out, "out/%s", w.sc.name);
   if (!w.check) {
-    const int ne = dir_nonempty(w.out);
+    const int ne = (int)wf_par_total(wf_par_rank() == 0 ? dir_nonempty(w.out) : 0); /* rank 0's */
     if (ne < 0) return finish(&w, fail(&w, MPMC_ERR_IO, "output '%s' is not a directory", w.out));
     if (ne > 0 && !(flags & MPMC_WORKFLOW_FORCE)) {
       w.out[0] = '\0';
@@ -814,8 +829,12 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
     say(&w, "check: %s is valid", scene);
     return finish(&w, 0);
   }
-  if (mkdir_p(w.out)) return finish(&w, fail(&w, MPMC_ERR_IO, "cannot create '%s': %s", w.out, strerror(errno)));
-  if ((flags & MPMC_WORKFLOW_FORCE) && remove_old_outputs(&w)) return finish(&w, last_code(ctx));
+  /* over MPI rank 0 makes the directory and clears it, and every rank knows how it went */
+  if (wf_par_agree(wf_par_rank() == 0 && mkdir_p(w.out) ? MPMC_ERR_IO : 0))
+    return finish(&w, fail(&w, MPMC_ERR_IO, "cannot create '%s': %s", w.out, strerror(errno)));
+  if ((flags & MPMC_WORKFLOW_FORCE) && wf_par_agree(wf_par_rank() == 0 ? remove_old_outputs(&w) : 0))
+    return finish(&w, wf_par_rank() == 0 ? last_code(ctx)
+                                         : fail(&w, MPMC_ERR_IO, "--force: rank 0 cannot remove the old outputs"));
   say(&w, "output: %s", w.out);
   if (open_outputs(&w, 0)) return finish(&w, last_code(ctx));
   const int err = run_all(&w, 0, NULL, 0, 0);
@@ -851,7 +870,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
   snprintf(path, sizeof path, "%s/checkpoint.h5", outdir);
   mpmc_sim sim = NULL;
   char *meta = NULL;
-  WF_CALL(mpmc_sim_checkpoint_read(ctx, path, &sim, &meta));
+  WF_CALL(wf_par_checkpoint_read(ctx, path, &sim, &meta));
   /* the workflow's record */
   wf_record rec;
   char why[WF_MSG] = "";
@@ -951,8 +970,10 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     if (!err) {
       char series[WF_PATH], msg[WF_MSG];
       out_path(&w, "series.csv", series, sizeof series);
-      if (wf_series_trim(series, &w.sc, rec.steps, &w.series_rows, msg, sizeof msg))
-        err = fail(&w, MPMC_ERR_IO, "resume: %s", msg);
+      msg[0] = '\0';
+      const int bad_trim = wf_par_rank() == 0 && wf_series_trim(series, &w.sc, rec.steps, &w.series_rows, msg, sizeof msg);
+      w.series_rows = (int)wf_par_total(w.series_rows); /* rank 0's count (the others' are 0) */
+      if (wf_par_agree(bad_trim ? MPMC_ERR_IO : 0)) err = fail(&w, MPMC_ERR_IO, "resume: %s", msg);
     }
     if (!err) err = open_outputs(&w, 1) ? last_code(ctx) : 0;
     if (!err) {

@@ -40,13 +40,14 @@ static void csv_name(const wf_scene *sc, const wf_snapplot *p, int j, char *buf,
 static int write_csv_fields(mpmc_sim sim, const wf_scene *sc, const wf_snapplot *p, const char *path, double t) {
   int np, e;
   double *x, *x0, *v, *sig, *eps = NULL;
-  mpmc_sim_get_num_particles(sim, &np);
-  if ((e = mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL)) ||
-      (e = mpmc_sim_get_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
-      (e = mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL)) ||
-      (e = mpmc_sim_get_field(sim, MPMC_FIELD_STRESS, &sig, NULL)))
+  wf_all_count(sim, &np);
+  if ((e = wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL)) ||
+      (e = wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
+      (e = wf_all_field(sim, MPMC_FIELD_VELOCITY, &v, NULL)) ||
+      (e = wf_all_field(sim, MPMC_FIELD_STRESS, &sig, NULL)))
     return e;
-  if (p->color == WF_COLOR_EPS_P && (e = mpmc_sim_get_field(sim, MPMC_FIELD_EPS_P, &eps, NULL))) return e;
+  if (p->color == WF_COLOR_EPS_P && (e = wf_all_field(sim, MPMC_FIELD_EPS_P, &eps, NULL))) return e;
+  if (wf_par_rank() != 0) return 0; /* over MPI: rank 0 writes (all ranks gathered) */
   const int d = sc->dim;
   int hx, vy;
   wf_view_axes(sc, &hx, &vy);
@@ -112,7 +113,7 @@ int wf_snapplots_step(mpmc_sim sim, const wf_scene *sc, const char *outdir, int 
       char name[WF_NAME * 2 + 64], path[WF_PATH + WF_NAME * 2 + 64];
       csv_name(sc, p, j, name, sizeof name);
       snprintf(path, sizeof path, "%s/%s", outdir, name);
-      const int e = write_csv(sim, sc, p, path, t_stage);
+      const int e = wf_par_agree(write_csv(sim, sc, p, path, t_stage)); /* rank 0 writes */
       if (e) {
         snprintf(msg, len, "snapshot_plots.%d: cannot write %s", k, path);
         return e;

@@ -383,6 +383,31 @@ int wf_snapplots_plot(const wf_scene *sc, const char *outdir, char *warn, size_t
 int wf_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
                  int material, int *first, int *count, char *msg, size_t len);
 
+/* ---- over MPI (par.c) ---------------------------------------------------------------- */
+/* The run's ranks: over MPI (an MPI build, MPI initialised with several ranks) those of
+ * MPI_COMM_WORLD; otherwise rank 0 of 1.  Rank 0 writes the front end's files and the log. */
+int wf_par_size(void);
+int wf_par_rank(void);
+/* The same code on every rank: the lowest failing rank's (collective; err as it is alone). */
+int wf_par_agree(int err);
+/* Rank 0's buf on every rank; the sum and the largest of v over the ranks (collective). */
+void wf_par_share(char *buf, int len);
+long wf_par_total(long v);
+double wf_par_max(double v);
+/* A simulation over the run's ranks; one read back from a checkpoint over them. */
+int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim);
+int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);
+/* The log's line on the decomposition ("" in one process). */
+void wf_par_plan(mpmc_sim sim, char *line, size_t len);
+/* Every point, read only (collective): like mpmc_sim_get_num_particles / _get_field /
+ * _get_particle_ids / _get_material_ids, but over MPI every rank's points, gathered in the
+ * order of their global ids (valid until the next call for the same field). */
+int wf_all_count(mpmc_sim sim, int *n);
+int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp);
+int wf_all_ids(mpmc_sim sim, const int **ids);
+int wf_all_materials(mpmc_sim sim, const int **mat);
+void wf_all_release(void);
+
 /* Monotonic wall-clock seconds (report.c). */
 double wf_now(void);
 

@@ -50,6 +50,10 @@ int mpmc_sim_set_geostatic_stress(mpmc_sim sim, double k0) {
   MPMC_CHECK(g > 0, ctx, MPMC_ERR_ARG,
              "geostatic stress: gravity along %c is %g: set a downward gravity first", "xyz"[v],
              sim->gravity[v]);
+  /* a column's overburden and the median spacing are over points other ranks may hold */
+  MPMC_CHECK(mpmc_dd_ranks(sim) == 1, ctx, MPMC_ERR_UNSUPPORTED,
+             "geostatic stress (initial_stress.k0) is not available over MPI (%d ranks) yet: "
+             "initialise the stresses with a gravity stage instead", mpmc_dd_ranks(sim));
   MPMC_CALL(mpmc_sim_prepare(sim));
   mpmc_particles *p = &sim->p;
   const int n = p->n;

@@ -1,0 +1,264 @@
+/* The front end over MPI (docs/mpi.md, "The mpmc front end").
+ *
+ * In a build with -DMPMC_WITH_MPI=ON a run whose program has initialised MPI with more than
+ * one rank in MPI_COMM_WORLD (`mpirun -np 4 mpmc run SCENE.yaml`) is one simulation over those
+ * ranks (mpmc_sim_create_mpi); otherwise, and always in the serial build, it is the
+ * one-process run, unchanged.  Every rank runs the same workflow: it reads the scene, makes
+ * the same library calls (all collective) and takes the same decisions; rank 0 alone writes
+ * the files of the front end (series.csv, summary.json, plots) and the log.
+ *
+ * The front end's own reading of the points (metrics, plots, the factor of safety's
+ * verdict) goes through wf_all_*: in one process the library's arrays as they are; over
+ * MPI every rank's points gathered on every rank and put in the order of their global ids,
+ * so that each rank computes the same metrics, to the bit, whatever the number of ranks.
+ * A gather costs O(all points) per call: it is done per series row and plot, not per step. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "wf.h"
+
+#ifdef MPMC_HAVE_MPI
+#include "mpmc_mpi.h"
+
+static int distributed(void) {
+  static int known = 0, yes = 0;
+  if (!known) {
+    int init = 0, fin = 0, size = 1;
+    MPI_Initialized(&init);
+    MPI_Finalized(&fin);
+    if (init && !fin) MPI_Comm_size(MPI_COMM_WORLD, &size);
+    yes = size > 1;
+    known = 1;
+  }
+  return yes;
+}
+
+int wf_par_size(void) {
+  int size = 1;
+  if (distributed()) MPI_Comm_size(MPI_COMM_WORLD, &size);
+  return size;
+}
+
+int wf_par_rank(void) {
+  int rank = 0;
+  if (distributed()) MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank;
+}
+
+int wf_par_agree(int err) {
+  if (!distributed()) return err;
+  /* the code of the lowest rank that failed: rank 0's when it is the one (its files) */
+  int rank, mine[2], first[2];
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  mine[0] = err ? rank : 1 << 30;
+  mine[1] = err;
+  MPI_Allreduce(mine, first, 1, MPI_2INT, MPI_MINLOC, MPI_COMM_WORLD);
+  return first[0] == 1 << 30 ? 0 : first[1];
+}
+
+void wf_par_share(char *buf, int len) {
+  if (distributed()) MPI_Bcast(buf, len, MPI_CHAR, 0, MPI_COMM_WORLD);
+}
+
+double wf_par_max(double v) {
+  double m = v;
+  if (distributed()) MPI_Allreduce(&v, &m, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return m;
+}
+
+long wf_par_total(long v) {
+  long all = v;
+  if (distributed()) MPI_Allreduce(&v, &all, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  return all;
+}
+
+int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
+  return distributed() ? mpmc_sim_create_mpi(ctx, MPI_COMM_WORLD, dim, sim) : mpmc_sim_create(ctx, dim, sim);
+}
+
+int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta) {
+  return distributed() ? mpmc_sim_checkpoint_read_mpi(ctx, MPI_COMM_WORLD, path, sim, meta)
+                       : mpmc_sim_checkpoint_read(ctx, path, sim, meta);
+}
+
+void wf_par_plan(mpmc_sim sim, char *line, size_t len) {
+  int rank, nranks, axis, lo, hi;
+  line[0] = '\0';
+  if (!distributed() || mpmc_sim_get_mpi_slab(sim, &rank, &nranks, &axis, &lo, &hi)) return;
+  int threads = 1;
+#ifdef _OPENMP
+  threads = omp_get_max_threads();
+#endif
+  snprintf(line, len, "MPI: %d ranks x %d threads, slabs of grid cells along %c (rank 0: cells %d to %d)", nranks,
+           threads, "xyz"[axis], lo, hi - 1);
+}
+
+/* ---- the gathered view ----------------------------------------------------------------- */
+typedef struct {
+  void *buf;
+  size_t cap;
+} slot;
+static slot slots[MPMC_FIELD_COUNT + 2]; /* the fields, then ids and material ids */
+
+static void *grow(slot *s, size_t bytes) {
+  if (bytes > s->cap) {
+    void *p = realloc(s->buf, bytes);
+    if (!p) return NULL;
+    s->buf = p;
+    s->cap = bytes;
+  }
+  return s->buf;
+}
+
+/* Every rank's n local items of `width` values (MPI type t, `size` bytes each) gathered on
+ * every rank in the order of the points' global ids, into slot s.  *total: the points. */
+static int gather(mpmc_sim sim, const void *local, int *width_io, MPI_Datatype t, size_t size, slot *s, int *total) {
+  int width = *width_io;
+  int n = 0, size_w;
+  const int *ids = NULL;
+  mpmc_sim_get_num_particles(sim, &n);
+  if (n > 0 && mpmc_sim_get_particle_ids(sim, &ids)) n = -1;
+  /* every rank's width (a rank without points may not hold the array) */
+  int wmax = width;
+  MPI_Allreduce(&width, &wmax, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  width = *width_io = wmax;
+  if (wf_par_agree(n < 0 ? MPMC_ERR_STATE : 0)) return MPMC_ERR_STATE;
+  MPI_Comm_size(MPI_COMM_WORLD, &size_w);
+  int *counts = malloc(sizeof(int) * (size_t)size_w * 2);
+  if (!counts) return MPMC_ERR_MEMORY;
+  int *displs = counts + size_w;
+  MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, MPI_COMM_WORLD);
+  long all = 0;
+  for (int r = 0; r < size_w; ++r) {
+    displs[r] = (int)all;
+    all += counts[r];
+  }
+  int *gid = malloc(sizeof(int) * (size_t)(all + 1));
+  char *vals = malloc(size * (size_t)width * (size_t)(all + 1));
+  int err = !gid || !vals ? MPMC_ERR_MEMORY : 0;
+  if (!err) {
+    MPI_Allgatherv(ids, n, MPI_INT, gid, counts, displs, MPI_INT, MPI_COMM_WORLD);
+    for (int r = 0; r < size_w; ++r) {
+      counts[r] *= width;
+      displs[r] *= width;
+    }
+    MPI_Allgatherv(local, n * width, t, vals, counts, displs, t, MPI_COMM_WORLD);
+    int top = -1; /* ids are unique; order them by a table over [0, largest id] */
+    for (long k = 0; k < all; ++k) top = gid[k] > top ? gid[k] : top;
+    long *at = malloc(sizeof(long) * (size_t)(top + 2));
+    char *out = grow(s, size * (size_t)width * (size_t)(all + 1));
+    if (!at || !out)
+      err = MPMC_ERR_MEMORY;
+    else {
+      for (long k = 0; k <= top; ++k) at[k] = -1;
+      for (long k = 0; k < all; ++k) at[gid[k]] = k;
+      long j = 0;
+      for (long k = 0; k <= top; ++k)
+        if (at[k] >= 0) memcpy(out + size * (size_t)width * (size_t)j++, vals + size * (size_t)width * (size_t)at[k],
+                               size * (size_t)width);
+      *total = (int)all;
+    }
+    free(at);
+  }
+  free(gid);
+  free(vals);
+  free(counts);
+  return err;
+}
+
+int wf_all_count(mpmc_sim sim, int *n) {
+  int e = mpmc_sim_get_num_particles(sim, n);
+  if (!e && distributed()) {
+    int local = *n;
+    MPI_Allreduce(&local, n, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  }
+  return e;
+}
+
+/* A rank without points may hold no array: its part is empty; the others' code decides. */
+static int local_part(mpmc_sim sim, int e) {
+  int n = 0;
+  mpmc_sim_get_num_particles(sim, &n);
+  return wf_par_agree(n == 0 ? 0 : e);
+}
+
+int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
+  int w = 0, total = 0;
+  double *local = NULL;
+  int e = mpmc_sim_get_field(sim, field, &local, &w);
+  if (ncomp) *ncomp = w;
+  if (!distributed()) {
+    *data = local;
+    return e;
+  }
+  /* a field this simulation does not have is missing on every rank alike */
+  if ((e = local_part(sim, e))) return e;
+  e = gather(sim, local, &w, MPI_DOUBLE, sizeof(double), &slots[field], &total);
+  if (ncomp) *ncomp = w;
+  if (field == MPMC_FIELD_POSITION) mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, &local);
+  *data = e ? NULL : slots[field].buf;
+  return e;
+}
+
+static int view_ints(mpmc_sim sim, const int *local, int e, int which, const int **out) {
+  int total = 0;
+  if (!distributed()) {
+    *out = local;
+    return e;
+  }
+  if ((e = local_part(sim, e))) return e;
+  int one = 1;
+  e = gather(sim, local, &one, MPI_INT, sizeof(int), &slots[MPMC_FIELD_COUNT + which], &total);
+  *out = e ? NULL : slots[MPMC_FIELD_COUNT + which].buf;
+  return e;
+}
+
+int wf_all_ids(mpmc_sim sim, const int **ids) {
+  const int *local = NULL;
+  const int e = mpmc_sim_get_particle_ids(sim, &local);
+  return view_ints(sim, local, e, 0, ids);
+}
+
+int wf_all_materials(mpmc_sim sim, const int **mat) {
+  const int *local = NULL;
+  const int e = mpmc_sim_get_material_ids(sim, &local);
+  return view_ints(sim, local, e, 1, mat);
+}
+
+void wf_all_release(void) {
+  for (size_t k = 0; k < sizeof slots / sizeof *slots; ++k) {
+    free(slots[k].buf);
+    slots[k].buf = NULL;
+    slots[k].cap = 0;
+  }
+}
+
+#else /* one process: the library's arrays as they are */
+
+int wf_par_size(void) { return 1; }
+void wf_par_plan(mpmc_sim sim, char *line, size_t len) {
+  (void)sim;
+  if (len) line[0] = '\0';
+}
+int wf_par_rank(void) { return 0; }
+int wf_par_agree(int err) { return err; }
+void wf_par_share(char *buf, int len) { (void)buf, (void)len; }
+long wf_par_total(long v) { return v; }
+double wf_par_max(double v) { return v; }
+int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) { return mpmc_sim_create(ctx, dim, sim); }
+int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta) {
+  return mpmc_sim_checkpoint_read(ctx, path, sim, meta);
+}
+int wf_all_count(mpmc_sim sim, int *n) { return mpmc_sim_get_num_particles(sim, n); }
+int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
+  return mpmc_sim_get_field(sim, field, data, ncomp);
+}
+int wf_all_ids(mpmc_sim sim, const int **ids) { return mpmc_sim_get_particle_ids(sim, ids); }
+int wf_all_materials(mpmc_sim sim, const int **mat) { return mpmc_sim_get_material_ids(sim, mat); }
+void wf_all_release(void) {}
+
+#endif
