@@ -148,6 +148,25 @@ static int select_rows(hid_t g, mpmc_sim sim, ckpt_rows *k) {
 
 /* ---- block: configuration, grid, time, statistics ----------------------------------------- */
 
+/* Adaptive damping's node store as one array: in one process the rank's own; over MPI each
+ * node from the rank whose slab holds its plane (damping.c: a node with mass last step holds
+ * the same values on every rank that has it), the others' zero, summed over the ranks.  A
+ * restart on any number of ranks then finds every node's last force.  NULL: no memory. */
+static double *adaptive_nodes(const mpmc_sim sim) {
+  if (!sim->dd || sim->adr_own[0] < 0) return sim->adr_f;
+  double *a = malloc(sim->adr_nf * sizeof *a);
+  if (!a) return NULL;
+  const int ax = sim->adr_own[0], w = 1 + sim->dim;
+  const long n0 = sim->grid.n[0], n1 = sim->grid.n[1];
+  for (size_t i = 0; i < sim->grid.nn; ++i) {
+    const long k = ax == 0 ? (long)i % n0 : ax == 1 ? (long)i / n0 % n1 : (long)i / (n0 * n1);
+    const int mine = k >= sim->adr_own[1] && k < sim->adr_own[2];
+    for (int c = 0; c < w; ++c) a[i * (size_t)w + c] = mine ? sim->adr_f[i * (size_t)w + c] : 0.0;
+  }
+  mpmc_dd_sum(sim, a, (int)sim->adr_nf); /* x + 0: the owner's values, exactly */
+  return a;
+}
+
 static int write_config(hid_t f, const mpmc_sim sim) {
   hid_t g = H5Gcreate2(f, "config", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) return -1;
@@ -176,9 +195,13 @@ static int write_config(hid_t f, const mpmc_sim sim) {
   const double ad[4] = {sim->adr ? sim->adr_zeta : 0.0, sim->adr_c, sim->adr_sum[0],
                         sim->adr_sum[1]};
   st |= mpmc_h5_attr_write(g, "adaptive_damping", H5T_NATIVE_DOUBLE, 4, ad);
-  if (sim->adr && sim->adr_nf)
+  if (sim->adr && sim->adr_nf) {
+    double *nodes = adaptive_nodes(sim);
+    if (!nodes) return -1;
     st |= mpmc_h5_dataset_write(g, "adaptive_damping_nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                                sim->grid.nn, (size_t)(1 + sim->dim), sim->adr_f);
+                                sim->grid.nn, (size_t)(1 + sim->dim), nodes);
+    if (nodes != sim->adr_f) free(nodes);
+  }
   st |= mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &sim->time);
   st |= mpmc_h5_attr_write(g, "grid_lo", H5T_NATIVE_DOUBLE, 3, gr->lo);
   st |= mpmc_h5_attr_write(g, "grid_hi", H5T_NATIVE_DOUBLE, 3, gr->hi);
@@ -1130,9 +1153,6 @@ int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "checkpoint: no grid set, nothing to save");
   int rank, size;
   mpmc_io_ranks(sim, &rank, &size);
-  MPMC_CHECK(size == 1 || !sim->adr, ctx, MPMC_ERR_UNSUPPORTED,
-             "checkpoint over %d MPI ranks: adaptive damping's estimate and node store are each "
-             "rank's own, not yet one state to save; turn it off or run on one rank", size);
   const size_t len = strlen(path) + 5;
   char *tmp = malloc(len);
   MPMC_CHECK(tmp, ctx, MPMC_ERR_MEMORY, "cannot allocate a path");

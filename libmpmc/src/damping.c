@@ -27,6 +27,9 @@
 #include <stdlib.h>
 
 #include "mpmc_impl.h"
+#ifdef MPMC_HAVE_MPI
+#include "mpmc_mpi.h"
+#endif
 
 /* the running means' memory: a step's sums weigh 1 - ADR_KEEP */
 #define ADR_KEEP 0.9
@@ -79,6 +82,17 @@ int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow) {
     sim->adr_rows = r;
     sim->adr_nrows = (size_t)nrow;
   }
+  sim->adr_own[0] = -1;
+#ifdef MPMC_HAVE_MPI
+  /* over MPI a halo node holds the same sums on both ranks (mpi.c): it counts on the rank
+   * whose slab holds the cell above it, the top plane on the last rank */
+  int rank, nranks, axis, lo, hi;
+  if (sim->dd && !mpmc_sim_get_mpi_slab(sim, &rank, &nranks, &axis, &lo, &hi)) {
+    sim->adr_own[0] = axis;
+    sim->adr_own[1] = lo;
+    sim->adr_own[2] = rank == nranks - 1 ? sim->grid.n[axis] : hi;
+  }
+#endif
   return MPMC_SUCCESS;
 }
 
@@ -88,6 +102,10 @@ void mpmc_adaptive_damping_finish(struct mpmc_sim_s *sim, long nrow) {
     num += sim->adr_rows[2 * r];
     den += sim->adr_rows[2 * r + 1];
   }
+  double both[2] = {num, den};
+  mpmc_dd_sum(sim, both, 2); /* MPI: over the ranks, in rank order (the same c on each) */
+  num = both[0];
+  den = both[1];
   sim->adr_sum[0] = ADR_KEEP * sim->adr_sum[0] + (1.0 - ADR_KEEP) * num;
   sim->adr_sum[1] = ADR_KEEP * sim->adr_sum[1] + (1.0 - ADR_KEEP) * den;
   if (!(sim->adr_sum[1] > 0.0)) return; /* no motion yet: c stays */

@@ -22,6 +22,8 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   const double ca = (2.0 - cdt) / (2.0 + cdt), cb = 2.0 * dt / (2.0 + cdt);
   double *restrict fprev = sim->adr_f;
   double *restrict rowsum = sim->adr_rows;
+  const int oax = adr ? sim->adr_own[0] : -1; /* MPI: the nodes this rank sums (damping.c) */
+  const long olo = sim->adr_own[1], ohi = sim->adr_own[2], n0 = g->n[0], n1 = g->n[1];
 #pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long row = 0; row < nrow; ++row) {
     size_t len;
@@ -42,7 +44,11 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
         /* the Rayleigh quotient's terms over the free components: dx = v dt moved the
          * material, df = f^n - f^{n-1} = -K dx, so omega^2 = v.(f^{n-1} - f^n) / (dt m v.v) */
         double *restrict fp = fprev + i * (size_t)(1 + DIM);
-        const int both = fp[0] == stamp - 1.0;
+        int both = fp[0] == stamp - 1.0;
+        if (oax >= 0) {
+          const long k = oax == 0 ? (long)i % n0 : oax == 1 ? (long)i / n0 % n1 : (long)i / (n0 * n1);
+          both &= k >= olo && k < ohi;
+        }
         for (int a = 0; a < DIM; ++a) {
           if (both && !(fl & (73u << a))) {
             num += v0[a] * (fp[1 + a] - f[a]);

@@ -419,6 +419,8 @@ struct mpmc_sim_s {
   size_t adr_nf;      /* doubles in adr_f (0: none)                                     */
   double *adr_rows;   /* [rows][2] the grid update's per-row sums, added in row order   */
   size_t adr_nrows;
+  int adr_own[3];     /* over MPI: the slab axis and the node planes [lo, hi) along it whose
+                       * nodes this rank adds to the sums (each halo node once); axis -1: all */
   int solver;
   int nthreads;
   int force_dt;

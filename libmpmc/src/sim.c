@@ -26,6 +26,7 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
   s->solver = MPMC_SOLVER_AUTO;
   s->sort_last = -1;
   s->sort_axis = -1;
+  s->adr_own[0] = -1; /* adaptive damping: every node its own until a step over MPI says */
   s->p.dim = dim;
   const int err = mpmc_kernels_from_env(s);
   if (err) {
@@ -194,8 +195,6 @@ int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(isfinite(zeta) && zeta >= 0 && zeta <= 2, sim->ctx, MPMC_ERR_ARG,
              "adaptive damping ratio zeta = %g must be in [0, 2] (1: critical, 0: off)", zeta);
-  MPMC_CHECK(zeta == 0 || !sim->dd, sim->ctx, MPMC_ERR_UNSUPPORTED,
-             "adaptive damping is not supported over MPI yet");
   sim->adr = zeta > 0;
   sim->adr_zeta = zeta;
   sim->adr_c = 0.0;
