@@ -710,7 +710,8 @@ static int group_points(mpmc_sim sim, const simplices *B, const char *name, cons
   for (int q = 0; q < count; ++q)
     if (in[q]) (*idx)[m++] = first + q;
   free(in);
-  if (m == 0) mpmc_log(sim->ctx, MPMC_LOG_WARNING, "gmsh: no seeded point lies near group '%s'", name);
+  /* over MPI another rank may hold the group's points: no warning from a rank alone */
+  if (m == 0 && !sim->dd) mpmc_log(sim->ctx, MPMC_LOG_WARNING, "gmsh: no seeded point lies near group '%s'", name);
   *n = m;
   return MPMC_SUCCESS;
 }
@@ -878,10 +879,12 @@ int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode,
     else
       err = seed_quadrature(&s, sim, groups[ireg].tag, region, ppc, material, &f0, &cnt);
   }
-  if (!err && mode == MPMC_SEED_QUADRATURE) { /* mean spacing of the Gauss points */
+  /* the points this process holds: over MPI its slab's of the cnt seeded (mpi.c) */
+  const int mine = err ? 0 : sim->p.n - f0;
+  if (!err && mode == MPMC_SEED_QUADRATURE && mine > 0) { /* mean spacing of the Gauss points */
     double v = 0;
-    for (int q = 0; q < cnt; ++q) v += sim->p.vol0[f0 + q];
-    spacing = pow(v / cnt, 1.0 / d);
+    for (int q = 0; q < mine; ++q) v += sim->p.vol0[f0 + q];
+    spacing = pow(v / mine, 1.0 / d);
   }
   /* boundary and point groups -> particle sets of the new points and node sets; all are
    * computed before any is added, so that a failure leaves the sim as it was */
@@ -893,7 +896,7 @@ int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode,
   groupset *gs = err ? NULL : calloc(ngroup + 1, sizeof *gs);
   if (!err && !gs) err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "gmsh: cannot allocate %zu sets", ngroup);
   buckets bk = {0, 0, {1, 1, 1}, NULL, NULL};
-  if (!err) err = buckets_build(sim, f0, cnt, &bk);
+  if (!err) err = buckets_build(sim, f0, mine, &bk);
   for (size_t i = 0; i < ngroup && !err; ++i) {
     if (groups[i].dim >= d || !groups[i].name || !groups[i].name[0]) continue;
     if (groups[i].dim > 0 && groups[i].dim < d - 1) continue; /* curves in 3D: not a boundary */
@@ -913,7 +916,7 @@ int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode,
   for (size_t i = 0; gs && i < ngroup; ++i) free(gs[i].pidx), free(gs[i].ijk);
   free(gs);
   /* a failure after the points were added takes them back */
-  if (err && cnt > 0 && sim->p.n == f0 + cnt) {
+  if (err && mine > 0 && sim->p.n == f0 + mine) {
     sim->p.n = f0;
     sim->prepared = 0;
   }
