@@ -11,9 +11,10 @@ if(CMAKE_SCRIPT_MODE_FILE)
   #  - mpmc_context_last_error returns a pointer into the context's message buffer, which a
   #    Fortran string cannot borrow safely; the module's mpmc_context_last_error is a Fortran
   #    function of the same name that copies the message through mpmc_context_get_last_error.
-  #  - mpmc_sim_create_mpi takes an MPI_Comm, a C handle Fortran cannot pass; the module
-  #    binds mpmc_sim_create_mpi_f, which takes MPI's Fortran handle (MPI_Comm_f2c).
-  set(NOT_BOUND mpmc_context_last_error mpmc_sim_create_mpi)
+  #  - mpmc_sim_create_mpi and mpmc_sim_checkpoint_read_mpi take an MPI_Comm, a C handle
+  #    Fortran cannot pass; the module binds their _f twins, which take MPI's Fortran handle
+  #    (MPI_Comm_f2c).
+  set(NOT_BOUND mpmc_context_last_error mpmc_sim_create_mpi mpmc_sim_checkpoint_read_mpi)
 
   include(${CMAKE_CURRENT_LIST_DIR}/../libmpmc/public_api.cmake)
   string(REPLACE "," ";" HEADERS "${HEADERS}")

@@ -22,6 +22,13 @@ int mpmc_sim_create_mpi(mpmc_context ctx, MPI_Comm comm, int dim, mpmc_sim *sim)
 /* The same for Fortran: comm is MPI's Fortran handle (mpi_f08's comm%MPI_VAL, or the
  * integer of the mpi module). */
 int mpmc_sim_create_mpi_f(mpmc_context ctx, MPI_Fint comm, int dim, mpmc_sim *sim);
+/* A simulation over comm from a checkpoint (mpmc_sim_checkpoint_write) written by any number
+ * of ranks or by one process: each rank keeps the points of its slab, with their global ids
+ * and every field (collective; checkpoint.c).  _f: MPI's Fortran handle. */
+int mpmc_sim_checkpoint_read_mpi(mpmc_context ctx, MPI_Comm comm, const char *path, mpmc_sim *sim,
+                                 char **meta);
+int mpmc_sim_checkpoint_read_mpi_f(mpmc_context ctx, MPI_Fint comm, const char *path,
+                                   mpmc_sim *sim, char **meta);
 /* This rank's place in the decomposition: its rank and the number of ranks, the slab axis
  * and the slab's cells [cell_lo, cell_hi) along it (grid cell 0 is the first ghost cell
  * below the box; a load balance moves them); the simulation's grid must be set.  Any
@@ -32,6 +39,8 @@ int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis,
  * the halo sums (after P2G, and F-bar's after G2P), and of migration (points moving to
  * another rank's slab, their counts included).  A message to a neighbour counts even when
  * empty; ranks at the ends send to one neighbour.  Any argument may be NULL. */
+int mpmc_sim_get_mpi_traffic(const mpmc_sim sim, double *halo_bytes, long *halo_msgs,
+                             double *migrated_bytes, long *migrate_msgs);
 /* Load balance: before a step, when every_n_steps steps passed since the last balance
  * (0: never by count) or when the most points on a rank exceed threshold times the mean
  * (0: never by threshold; else >= 1), the cuts move to split the points evenly (whole cells,
@@ -42,8 +51,6 @@ int mpmc_sim_set_mpi_balance(mpmc_sim sim, int every_n_steps, double threshold);
 /* The most points on a rank over the mean over the ranks (1: even), and the balances done
  * so far (cuts moved).  Collective; either argument may be NULL. */
 int mpmc_sim_get_mpi_imbalance(const mpmc_sim sim, double *imbalance, long *balances);
-int mpmc_sim_get_mpi_traffic(const mpmc_sim sim, double *halo_bytes, long *halo_msgs,
-                             double *migrated_bytes, long *migrate_msgs);
 
 #ifdef __cplusplus
 }

@@ -26,6 +26,9 @@
 
 #include "contact.h"
 #include "io_mpi.h"
+#ifdef MPMC_HAVE_MPI
+#include "mpmc_mpi.h"
+#endif
 #include "sets.h"
 
 #define CKPT_FORMAT "libmpmc-checkpoint"

@@ -40,14 +40,4 @@ herr_t mpmc_h5_rows_write(hid_t loc, const char *name, hid_t filetype, hid_t mem
                           long long total, size_t cols, long long offset, size_t n,
                           const void *buf, hid_t dxpl);
 
-#ifdef MPMC_HAVE_MPI
-#include <mpi.h>
-/* checkpoint.c: the restart over the ranks of comm from a checkpoint written by any number
- * of ranks (to be declared in mpmc_mpi.h, the public header of the MPI functions). */
-int mpmc_sim_checkpoint_read_mpi(mpmc_context ctx, MPI_Comm comm, const char *path, mpmc_sim *sim,
-                                 char **meta);
-int mpmc_sim_checkpoint_read_mpi_f(mpmc_context ctx, MPI_Fint comm, const char *path, mpmc_sim *sim,
-                                   char **meta);
-#endif
-
 #endif

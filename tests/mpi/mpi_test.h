@@ -59,10 +59,11 @@ static inline int test_lattice2(const double *lo, const double *hi, double h, in
 }
 
 /* Per point: position, velocity (dim each) and stress (6), at [id] of out[n][2 dim + 6]
- * (rank 0: every rank's points; the others pass out NULL).  Collective for an MPI sim. */
+ * (comm's rank 0: every rank's points; the others pass out NULL).  Collective over comm for
+ * a sim over comm; MPI_COMM_NULL: a sim in one process. */
 #define TEST_REC(d) (2 * (d) + 6)
-static inline void test_gather(mpmc_context ctx, mpmc_sim sim, int dim, int ntotal, int mpi,
-                        double *out) {
+static inline void test_gather_on(mpmc_context ctx, mpmc_sim sim, int dim, int ntotal, MPI_Comm comm,
+                                  double *out) {
   const int w = TEST_REC(dim);
   int n;
   const int *ids;
@@ -82,18 +83,21 @@ static inline void test_gather(mpmc_context ctx, mpmc_sim sim, int dim, int ntot
   MCALL(ctx, mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
   int count = n * (w + 1), *counts = NULL, *displ = NULL, total = count;
   double *all = mine;
-  if (mpi) {
-    if (test_rank == 0) {
-      counts = malloc(sizeof(int) * (size_t)test_size);
-      displ = malloc(sizeof(int) * (size_t)test_size);
+  if (comm != MPI_COMM_NULL) {
+    int rank, size;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &size);
+    if (rank == 0) {
+      counts = malloc(sizeof(int) * (size_t)size);
+      displ = malloc(sizeof(int) * (size_t)size);
     }
-    MPI_Gather(&count, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
-    if (test_rank == 0) {
+    MPI_Gather(&count, 1, MPI_INT, counts, 1, MPI_INT, 0, comm);
+    if (rank == 0) {
       total = 0;
-      for (int r = 0; r < test_size; ++r) displ[r] = total, total += counts[r];
+      for (int r = 0; r < size; ++r) displ[r] = total, total += counts[r];
       all = malloc(sizeof(double) * (size_t)(total > 0 ? total : 1));
     }
-    MPI_Gatherv(mine, count, MPI_DOUBLE, all, counts, displ, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    MPI_Gatherv(mine, count, MPI_DOUBLE, all, counts, displ, MPI_DOUBLE, 0, comm);
   }
   if (out) {
     for (int i = 0; i < ntotal * w; ++i) out[i] = NAN;
@@ -107,6 +111,12 @@ static inline void test_gather(mpmc_context ctx, mpmc_sim sim, int dim, int ntot
   free(mine);
   free(counts);
   free(displ);
+}
+
+/* test_gather_on over MPI_COMM_WORLD (mpi) or in one process. */
+static inline void test_gather(mpmc_context ctx, mpmc_sim sim, int dim, int ntotal, int mpi,
+                               double *out) {
+  test_gather_on(ctx, sim, dim, ntotal, mpi ? MPI_COMM_WORLD : MPI_COMM_NULL, out);
 }
 
 /* The largest difference of each of position, velocity and stress between runs a and b

@@ -9,8 +9,6 @@
  *    global id.
  *  - On 3 ranks or more, the block moving 25 m in one (forced) step, from the top rank's
  *    slab past the middle one's: MPMC_ERR_UNSTABLE, "more than one subdomain", on every rank.
- *  - A checkpoint or snapshots over several ranks: MPMC_ERR_UNSUPPORTED (no file written per
- *    process under one name; parallel HDF5 is to come).
  * Run with 2 and 3 ranks (tests/mpi.cmake). */
 #include "mpi_test.h"
 
@@ -140,24 +138,6 @@ int main(int argc, char **argv) {
   if (test_size >= 3)
     test_failed |= failure("block across two slabs in a step", -2500.0, 1e-2, MPMC_ERR_UNSTABLE,
                            "more than one subdomain");
-  { /* snapshots and checkpoints over several ranks: refused until parallel HDF5 comes */
-    mpmc_context ctx;
-    mpmc_context_create(&ctx);
-    int n, e1, e2;
-    mpmc_sim sim = block(ctx, MPI_COMM_WORLD, 0.0, 0.0, &n);
-    mpmc_output out = NULL;
-    e1 = mpmc_sim_checkpoint_write(sim, "t702-never.h5", NULL);
-    e2 = mpmc_output_create(sim, "t702-never-snap.h5", "t702-never.xdmf", &out);
-    if (e1 != MPMC_ERR_UNSUPPORTED || e2 != MPMC_ERR_UNSUPPORTED) {
-      printf("rank %d: checkpoint and snapshots over %d ranks returned %d and %d, expected %d "
-             "(MPMC_ERR_UNSUPPORTED): %s\n", test_rank, test_size, e1, e2,
-             MPMC_ERR_UNSUPPORTED, mpmc_context_last_error(ctx));
-      test_failed = 1;
-    }
-    mpmc_output_destroy(&out);
-    mpmc_sim_destroy(&sim);
-    mpmc_context_destroy(&ctx);
-  }
   MPI_Allreduce(MPI_IN_PLACE, &test_failed, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD);
   MPI_Finalize();
   return test_failed;

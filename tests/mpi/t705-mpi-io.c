@@ -306,11 +306,79 @@ static void one_rank(void) {
   mpmc_context_destroy(&ctx);
 }
 
+/* The first n ranks of MPI_COMM_WORLD (MPI_COMM_NULL on the others). */
+static MPI_Comm first(int n) {
+  MPI_Comm c;
+  MPI_Comm_split(MPI_COMM_WORLD, test_rank < n ? 0 : MPI_UNDEFINED, test_rank, &c);
+  return c;
+}
+
+/* N ranks -> M ranks over MPI: the first nw ranks run the column K steps, write the
+ * checkpoint and run K more; the first nr read it (mpmc_sim_checkpoint_read_mpi, each keeps
+ * its slab's points) and run K steps: the state read is the writers' to the bit, and the run
+ * the uninterrupted one to the bit when nr == nw, else within max(1e-12, 3 x the larger
+ * distance of either run from one process). */
+static void ranks_to_ranks(int nw, int nr) {
+  char ckpt[64];
+  snprintf(ckpt, sizeof ckpt, "t705-np%d-%d-to-%d.ckpt", test_size, nw, nr);
+  mpmc_context ctx;
+  mpmc_context_create(&ctx);
+  MPI_Comm cw = first(nw), cr = first(nr);
+  int n = 0;
+  double *rec[3] = {NULL, NULL, NULL}; /* at the checkpoint, uninterrupted, restarted */
+  for (int k = 0; k < 3 && test_rank == 0; ++k) rec[k] = malloc(sizeof(double) * 4000 * TEST_REC(2));
+  if (cw != MPI_COMM_NULL) {
+    mpmc_sim sim = column(ctx, cw, &n);
+    steps(ctx, sim, K);
+    test_gather_on(ctx, sim, 2, n, cw, rec[0]);
+    MCALL(ctx, mpmc_sim_checkpoint_write(sim, ckpt, NULL));
+    steps(ctx, sim, K);
+    test_gather_on(ctx, sim, 2, n, cw, rec[1]);
+    mpmc_sim_destroy(&sim);
+    MPI_Comm_free(&cw);
+  }
+  MPI_Bcast(&n, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (cr != MPI_COMM_NULL) {
+    mpmc_sim sim;
+    MCALL(ctx, mpmc_sim_checkpoint_read_mpi(ctx, cr, ckpt, &sim, NULL));
+    test_gather_on(ctx, sim, 2, n, cr, rec[2]);
+    char what[96];
+    snprintf(what, sizeof what, "%d ranks -> %d ranks: the state read", nw, nr);
+    if (test_rank == 0) same_bits(n, rec[2], rec[0], what);
+    steps(ctx, sim, K);
+    test_gather_on(ctx, sim, 2, n, cr, rec[2]);
+    mpmc_sim_destroy(&sim);
+    MPI_Comm_free(&cr);
+  }
+  if (test_rank == 0) {
+    double rel[3], band[3], band2[3]; /* the larger distance of either run from one process */
+    test_compare(2, n, rec[2], rec[1], rel);
+    ranks_band(ctx, n, rec[1], band);
+    ranks_band(ctx, n, rec[2], band2);
+    for (int f = 0; f < 3; ++f) band[f] = fmax(band[f], band2[f]);
+    for (int f = 0; f < 3; ++f)
+      if (nw == nr ? memcmp(rec[2], rec[1], sizeof(double) * (size_t)n * TEST_REC(2)) != 0
+                   : !(rel[f] <= fmax(TOL, 3 * band[f])))
+        FAIL("%s: field %d after the restart on %d ranks: %.3g from the run over %d (tolerance: "
+             "%s)", ckpt, f, nr, rel[f], nw, nw == nr ? "the same bits" : "3 x the band");
+    if (test_verbose())
+      printf("t705: %d ranks -> %d ranks, %d steps after the restart: position %.3g, velocity "
+             "%.3g, stress %.3g (either run against one process: %.3g, %.3g, %.3g)\n",
+             nw, nr, K, rel[0], rel[1], rel[2], band[0], band[1], band[2]);
+    remove(ckpt);
+  }
+  for (int k = 0; k < 3; ++k) free(rec[k]);
+  mpmc_context_destroy(&ctx);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &test_size);
   world_to_one();
+  ranks_to_ranks(test_size, test_size);     /* N -> N: the same bits */
+  ranks_to_ranks(test_size - 1, test_size); /* 2 -> 3 on 3 ranks, 1 -> 2 on 2 */
+  ranks_to_ranks(test_size, test_size - 1); /* 3 -> 2, 2 -> 1 */
   if (test_rank == 0) one_rank();
   MPI_Allreduce(MPI_IN_PLACE, &test_failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   MPI_Finalize();
