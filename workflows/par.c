@@ -97,6 +97,16 @@ void wf_par_plan(mpmc_sim sim, char *line, size_t len) {
            threads, "xyz"[axis], lo, hi - 1);
 }
 
+int wf_par_balance(mpmc_sim sim, int every, double threshold) {
+  return distributed() && (every > 0 || threshold > 0) ? mpmc_sim_set_mpi_balance(sim, every, threshold) : 0;
+}
+
+void wf_par_imbalance(mpmc_sim sim, double *imbalance, long *balances) {
+  *imbalance = 1.0;
+  *balances = 0;
+  if (distributed()) mpmc_sim_get_mpi_imbalance(sim, imbalance, balances);
+}
+
 /* ---- the gathered view ----------------------------------------------------------------- */
 typedef struct {
   void *buf;
@@ -240,6 +250,12 @@ void wf_all_release(void) {
 #else /* one process: the library's arrays as they are */
 
 int wf_par_size(void) { return 1; }
+int wf_par_balance(mpmc_sim sim, int every, double threshold) { return (void)sim, (void)every, (void)threshold, 0; }
+void wf_par_imbalance(mpmc_sim sim, double *imbalance, long *balances) {
+  (void)sim;
+  *imbalance = 1.0;
+  *balances = 0;
+}
 void wf_par_plan(mpmc_sim sim, char *line, size_t len) {
   (void)sim;
   if (len) line[0] = '\0';

@@ -286,6 +286,9 @@ void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const 
     st.kinsol_fallbacks = wf_par_total(st.kinsol_fallbacks);
     have_m = np > 0 && wf_metrics_compute(sim, sc, m) == 0;
   }
+  double imbalance = 1.0; /* over MPI: the most points on a rank over the mean, at the end */
+  long balances = 0;
+  if (sim) wf_par_imbalance(sim, &imbalance, &balances);
   FILE *f = wf_par_rank() == 0 ? fopen(path, "w") : NULL; /* rank 0 writes */
   if (!f) return;
   fputs("{\n  \"scene\": ", f);
@@ -315,6 +318,7 @@ void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const 
   threads = sc->threads > 0 ? sc->threads : omp_get_max_threads();
 #endif
   fprintf(f, "  \"ranks\": %d,\n  \"threads_per_rank\": %d,\n", wf_par_size(), threads);
+  if (wf_par_size() > 1) fprintf(f, "  \"imbalance\": %.4g,\n  \"balances\": %ld,\n", imbalance, balances);
   fprintf(f, "  \"particles\": %d,\n  \"steps\": %lld,\n  \"wall_seconds\": %.6g,\n", np, (long long)st.steps, wall);
   fprintf(f, "  \"step_wall_seconds\": %.6g,\n  \"particle_steps_per_second\": %.6g,\n", st.wall_seconds,
           st.wall_seconds > 0 ? (double)st.particle_steps / st.wall_seconds : 0.0);

@@ -219,6 +219,7 @@ static int build(wf_run *w) {
   WF_TRY(w, mpmc_sim_set_solver(sim, sc->solver), "solver");
   WF_TRY(w, mpmc_sim_set_threads(sim, sc->threads), "threads");
   WF_TRY(w, mpmc_sim_set_sort_interval(sim, sc->sort_interval), "sort_interval");
+  WF_TRY(w, wf_par_balance(sim, sc->balance_every, sc->balance_threshold), "load_balance");
   for (int i = 0; i < sc->nmat; ++i) {
     wf_material *m = &sc->mats[i];
     const int e = mpmc_sim_add_material(sim, wf_model_name(m->model), m->par, m->npar, &m->id);
@@ -963,6 +964,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
     w.ke_below = rec.ke_below;
     set_threads(&w);
     mpmc_sim_set_threads(w.sim, w.sc.threads);
+    if (wf_par_balance(w.sim, w.sc.balance_every, w.sc.balance_threshold)) err = last_code(ctx);
     sim = NULL;
     if (wf_metrics_init(w.sim, &w.sc)) err = last_code(ctx);
     say(&w, "resuming %s at stage %d/%d (%s), %.4g s into it", rec.scene, rec.stage + 1, w.sc.nstage,

@@ -968,7 +968,8 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   static const char *const keys[] = {"scene", "description", "dim", "geometry", "grid", "basis", "fbar",
                                      "flip", "solver", "threads", "materials", "stages", "metrics",
                                      "plots", "checkpoint_interval", "progress_interval", "rigid_bodies",
-                                     "contact", "snapshot_plots", "sort_interval", "water_table", NULL};
+                                     "contact", "snapshot_plots", "sort_interval", "water_table",
+                                     "load_balance", NULL};
   if (check_map(r, root, "", keys)) return -1;
   char def[WF_NAME];
   const char *base = strrchr(sc->path, '/');
@@ -1020,6 +1021,18 @@ static int read_scene(rd *r, const wf_node *root, wf_scene *sc) {
   if (get_enum(r, root, "", "solver", 0, MPMC_SOLVER_AUTO, solver_words, &sc->solver)) return -1;
   if (get_int(r, root, "", "threads", 0, 0, 0, 1024, &sc->threads)) return -1;
   if (get_int(r, root, "", "sort_interval", 0, 100, 0, 1000000000, &sc->sort_interval)) return -1;
+  const wf_node *lb = wf_map_get(root, "load_balance"); /* over MPI: the slab cuts follow the points */
+  if (lb) {
+    static const char *const lk[] = {"every", "threshold", NULL};
+    if (check_map(r, lb, "load_balance", lk) ||
+        get_int(r, lb, "load_balance", "every", 0, 0, 0, 1000000000, &sc->balance_every) ||
+        get_num(r, lb, "load_balance", "threshold", 0, 0, NONNEG, &sc->balance_threshold))
+      return -1;
+    if (sc->balance_threshold > 0 && sc->balance_threshold < 1)
+      return fail_at(r, wf_map_get(lb, "threshold"), "load_balance.threshold",
+                     "must be 0 (off) or >= 1, the most points on a rank over the mean (got %g)",
+                     sc->balance_threshold);
+  }
   if (get_bool(r, root, "", "plots", 1, &sc->plots)) return -1;
   if (get_num(r, root, "", "checkpoint_interval", 0, 300, POS, &sc->checkpoint_interval)) return -1;
   if (get_num(r, root, "", "progress_interval", 0, 5, POS, &sc->progress_interval)) return -1;

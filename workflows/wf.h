@@ -202,6 +202,8 @@ typedef struct {
   int dim;
   int basis, fbar, solver, threads;
   int sort_interval;        /* steps between sorts of the points by cell; 0: never */
+  int balance_every;        /* over MPI: balance the slabs every this many steps (0: not by count) */
+  double balance_threshold; /* ... or beyond this max/mean points (0: not by threshold)     */
   double flip;
   double lo[3], hi[3], h;
   int nmat;
@@ -399,6 +401,10 @@ int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim);
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);
 /* The log's line on the decomposition ("" in one process). */
 void wf_par_plan(mpmc_sim sim, char *line, size_t len);
+/* The scene's load_balance over MPI (mpmc_sim_set_mpi_balance); nothing in one process.
+ * After a run, *imbalance: the most points on a rank over the mean, *balances: done. */
+int wf_par_balance(mpmc_sim sim, int every, double threshold);
+void wf_par_imbalance(mpmc_sim sim, double *imbalance, long *balances);
 /* Every point, read only (collective): like mpmc_sim_get_num_particles / _get_field /
  * _get_particle_ids / _get_material_ids, but over MPI every rank's points, gathered in the
  * order of their global ids (valid until the next call for the same field). */
