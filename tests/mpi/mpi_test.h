@@ -26,6 +26,13 @@ static int test_rank, test_size, test_failed;
     }                                                                                     \
   } while (0)
 
+/* MPI_Init, and this process's rank and the number of ranks in test_rank, test_size. */
+static inline void test_init(int *argc, char ***argv) {
+  MPI_Init(argc, argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &test_size);
+}
+
 static inline int test_verbose(void) {
   const char *v = getenv("MPMC_TEST_VERBOSE");
   return v && *v && strcmp(v, "0") != 0;
@@ -56,6 +63,43 @@ static inline int test_lattice2(const double *lo, const double *hi, double h, in
       (*vol)[q] = dx * dx;
     }
   return n;
+}
+
+/* A Hencky block (E 1e5 Pa, nu 0.3, 1000 kg/m^3), 2 x 2 points a cell, x in [0, 1] and y in
+ * [ylo, yhi] of a 1 x 30 m grid of 0.5 m cells (B-spline2, anchored F-bar, gravity, slip
+ * sides, fixed base), moving at vy (1 + stretch (y - its middle)): the top faster than the
+ * bottom for stretch > 0, so it stretches and rings as it flies.  *n: the points over all
+ * ranks. */
+static inline mpmc_sim test_block(mpmc_context ctx, MPI_Comm comm, double ylo, double yhi, double vy,
+                                  double stretch, int *n) {
+  mpmc_sim sim = test_sim(ctx, comm, 2);
+  const double lo[2] = {0, 0}, hi[2] = {1, 30};
+  MCALL(ctx, mpmc_sim_set_grid(sim, lo, hi, 0.5));
+  MCALL(ctx, mpmc_sim_set_basis(sim, MPMC_BASIS_BSPLINE2));
+  MCALL(ctx, mpmc_sim_set_fbar(sim, MPMC_FBAR_ANCHORED));
+  const double gv[2] = {0, -9.81};
+  MCALL(ctx, mpmc_sim_set_gravity(sim, gv));
+  MCALL(ctx, mpmc_sim_set_threads(sim, 1));
+  int mat;
+  MCALL(ctx, mpmc_sim_add_material_hencky(sim, 1e5, 0.3, 1000.0, &mat));
+  double *x, *vol;
+  const double plo[2] = {0, ylo}, phi[2] = {1, yhi};
+  *n = test_lattice2(plo, phi, 0.5, 2, &x, &vol);
+  MCALL(ctx, mpmc_sim_add_particles(sim, *n, x, vol, mat, NULL));
+  free(x);
+  free(vol);
+  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
+  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
+  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  int nl;
+  double *v;
+  MCALL(ctx, mpmc_sim_get_num_particles(sim, &nl));
+  MCALL(ctx, mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
+  MCALL(ctx, mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL));
+  const double mid = 0.5 * (ylo + yhi);
+  for (int q = 0; q < nl; ++q) v[2 * q + 1] = vy * (1.0 + stretch * (x[2 * q + 1] - mid));
+  MCALL(ctx, mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
+  return sim;
 }
 
 /* Per point: position, velocity (dim each) and stress (6), at [id] of out[n][2 dim + 6]

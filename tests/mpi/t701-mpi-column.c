@@ -101,9 +101,7 @@ static int check(int basis, int fbar, double Hg, double *worst) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &test_size);
+  test_init(&argc, &argv);
   double worst[3] = {0, 0, 0};
   for (int b = 0; b < 4; ++b)
     for (int f = 0; f <= 4; ++f) test_failed |= check(b, f, 11.0, worst);

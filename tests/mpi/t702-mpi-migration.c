@@ -14,35 +14,9 @@
 
 #define TOL 1e-12
 
+/* The ringing block of 2 x 4 cells at y in [26, 28] (test_block). */
 static mpmc_sim block(mpmc_context ctx, MPI_Comm comm, double vy, double stretch, int *n) {
-  mpmc_sim sim = test_sim(ctx, comm, 2);
-  const double lo[2] = {0, 0}, hi[2] = {1, 30};
-  MCALL(ctx, mpmc_sim_set_grid(sim, lo, hi, 0.5));
-  MCALL(ctx, mpmc_sim_set_basis(sim, MPMC_BASIS_BSPLINE2));
-  MCALL(ctx, mpmc_sim_set_fbar(sim, MPMC_FBAR_ANCHORED));
-  const double gv[2] = {0, -9.81};
-  MCALL(ctx, mpmc_sim_set_gravity(sim, gv));
-  MCALL(ctx, mpmc_sim_set_threads(sim, 1));
-  int mat;
-  MCALL(ctx, mpmc_sim_add_material_hencky(sim, 1e5, 0.3, 1000.0, &mat));
-  double *x, *vol;
-  const double plo[2] = {0, 26}, phi[2] = {1, 28};
-  *n = test_lattice2(plo, phi, 0.5, 2, &x, &vol);
-  MCALL(ctx, mpmc_sim_add_particles(sim, *n, x, vol, mat, NULL));
-  free(x);
-  free(vol);
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
-  int nl;
-  double *v;
-  MCALL(ctx, mpmc_sim_get_num_particles(sim, &nl));
-  MCALL(ctx, mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
-  MCALL(ctx, mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL));
-  /* stretch > 0: the top faster than the bottom, the block stretches and rings as it flies */
-  for (int q = 0; q < nl; ++q) v[2 * q + 1] = vy * (1.0 + stretch * (x[2 * q + 1] - 27.0));
-  MCALL(ctx, mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
-  return sim;
+  return test_block(ctx, comm, 26.0, 28.0, vy, stretch, n);
 }
 
 /* The falling block; 1 if it failed. */
@@ -129,9 +103,7 @@ static int failure(const char *what, double vy, double dt, int code, const char 
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &test_size);
+  test_init(&argc, &argv);
   test_failed |= fall();
   test_failed |= failure("block thrown out of the grid", 200.0, 2e-3, MPMC_ERR_OUTSIDE,
                          "left the grid box");

@@ -58,9 +58,7 @@ static void column3(MPI_Comm comm, int reverse, int *ntotal, double *out) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &test_size);
+  test_init(&argc, &argv);
   const size_t len = (size_t)16 * 16 * 64 * TEST_REC(3);
   double *par = test_rank == 0 ? malloc(sizeof(double) * len) : NULL;
   int n;

@@ -372,9 +372,7 @@ static void ranks_to_ranks(int nw, int nr) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &test_size);
+  test_init(&argc, &argv);
   world_to_one();
   ranks_to_ranks(test_size, test_size);     /* N -> N: the same bits */
   ranks_to_ranks(test_size - 1, test_size); /* 2 -> 3 on 3 ranks, 1 -> 2 on 2 */

@@ -209,9 +209,7 @@ static int check(const rcase *c, const char *name) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &test_size);
+  test_init(&argc, &argv);
   const rcase cases[] = {
       {FOOTING, HENCKY, 0.0, {0.0, -0.02}, 1e-10}, {FOOTING, J2, 0.5, {0.3, -0.1}, TOL},
       {FOOTING, HENCKY, 0.5, {0.3, -0.1}, TOL},    {WALL, HENCKY, 0.0, {-0.1, 0.0}, TOL},

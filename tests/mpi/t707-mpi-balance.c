@@ -23,34 +23,9 @@
 #define EVERY 10
 #define THRESHOLD 1.3
 
+/* A block 12 m tall at y in [14, 26], falling and stretching (test_block). */
 static mpmc_sim block(mpmc_context ctx, MPI_Comm comm, int *n) {
-  mpmc_sim sim = test_sim(ctx, comm, 2);
-  const double lo[2] = {0, 0}, hi[2] = {1, 30};
-  MCALL(ctx, mpmc_sim_set_grid(sim, lo, hi, 0.5));
-  MCALL(ctx, mpmc_sim_set_basis(sim, MPMC_BASIS_BSPLINE2));
-  MCALL(ctx, mpmc_sim_set_fbar(sim, MPMC_FBAR_ANCHORED));
-  const double gv[2] = {0, -9.81};
-  MCALL(ctx, mpmc_sim_set_gravity(sim, gv));
-  MCALL(ctx, mpmc_sim_set_threads(sim, 1));
-  int mat;
-  MCALL(ctx, mpmc_sim_add_material_hencky(sim, 1e5, 0.3, 1000.0, &mat));
-  double *x, *vol;
-  const double plo[2] = {0, 14}, phi[2] = {1, 26};
-  *n = test_lattice2(plo, phi, 0.5, 2, &x, &vol);
-  MCALL(ctx, mpmc_sim_add_particles(sim, *n, x, vol, mat, NULL));
-  free(x);
-  free(vol);
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
-  int nl;
-  double *v;
-  MCALL(ctx, mpmc_sim_get_num_particles(sim, &nl));
-  MCALL(ctx, mpmc_sim_get_field(sim, MPMC_FIELD_VELOCITY, &v, NULL));
-  MCALL(ctx, mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL));
-  for (int q = 0; q < nl; ++q) v[2 * q + 1] = -10.0 * (1.0 + 0.05 * (x[2 * q + 1] - 20.0));
-  MCALL(ctx, mpmc_sim_restore_field(sim, MPMC_FIELD_VELOCITY, &v));
-  return sim;
+  return test_block(ctx, comm, 14.0, 26.0, -10.0, 0.05, n);
 }
 
 typedef struct {
@@ -111,9 +86,7 @@ static void run(int balanced, double *out, int *n, run_info *ri) {
 }
 
 int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &test_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &test_size);
+  test_init(&argc, &argv);
   const int nmax = 2 * 2 * 24 * 2;
   double *bal = test_rank == 0 ? malloc(sizeof(double) * nmax * TEST_REC(2)) : NULL;
   double *fix = test_rank == 0 ? malloc(sizeof(double) * nmax * TEST_REC(2)) : NULL;
