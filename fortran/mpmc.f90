@@ -342,6 +342,19 @@ module mpmc
       integer(c_long), intent(out) :: balances
       integer(c_int) :: ierr
     end function
+    ! mpmc_sim_checkpoint_read over the ranks of comm, as the C function (MPI builds only):
+    ! path a C string (trim(path)//c_null_char); meta the checkpoint's text (release it with
+    ! mpmc_free), or c_null_ptr
+    function mpmc_sim_checkpoint_read_mpi_f(ctx, comm, path, sim, meta) &
+        bind(C, name='mpmc_sim_checkpoint_read_mpi_f') result(ierr)
+      import :: c_int, c_char, c_ptr, mpmc_context, mpmc_sim
+      type(mpmc_context), value :: ctx
+      integer(c_int), value :: comm
+      character(kind=c_char), intent(in) :: path(*)
+      type(mpmc_sim), intent(out) :: sim
+      type(c_ptr), intent(out) :: meta
+      integer(c_int) :: ierr
+    end function
     function mpmc_sim_get_dim(sim, dim) bind(C, name='mpmc_sim_get_dim') result(ierr)
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
@@ -1058,16 +1071,6 @@ module mpmc
       type(c_ptr), intent(out) :: meta
       integer(c_int) :: ierr
     end function
-    function mpmc_sim_checkpoint_read_mpi_f_c(ctx, comm, path, sim, meta) &
-        bind(C, name='mpmc_sim_checkpoint_read_mpi_f') result(ierr)
-      import :: c_int, c_char, c_ptr, mpmc_context, mpmc_sim
-      type(mpmc_context), value :: ctx
-      integer(c_int), value :: comm
-      character(kind=c_char), intent(in) :: path(*)
-      type(mpmc_sim), intent(out) :: sim
-      type(c_ptr), intent(out) :: meta
-      integer(c_int) :: ierr
-    end function
     subroutine mpmc_free(ptr) bind(C, name='mpmc_free')
       import :: c_ptr
       type(c_ptr), value :: ptr
@@ -1465,22 +1468,6 @@ contains
     if (present(meta)) meta = f_string(pmeta)
     if (c_associated(pmeta)) call mpmc_free(pmeta)
   end function mpmc_sim_checkpoint_read
-
-  !> mpmc_sim_checkpoint_read over the ranks of comm (MPI's Fortran handle: mpi_f08's
-  !> comm%MPI_VAL or the mpi module's integer), each rank keeping the points of its slab.
-  function mpmc_sim_checkpoint_read_mpi_f(ctx, comm, path, sim, meta) result(ierr)
-    type(mpmc_context), intent(in) :: ctx
-    integer(c_int), intent(in) :: comm
-    character(*), intent(in) :: path
-    type(mpmc_sim), intent(out) :: sim
-    character(len=:), allocatable, intent(out), optional :: meta
-    integer(c_int) :: ierr
-    type(c_ptr) :: pmeta
-    pmeta = c_null_ptr
-    ierr = mpmc_sim_checkpoint_read_mpi_f_c(ctx, comm, mpmc_c_str(path), sim, pmeta)
-    if (present(meta)) meta = f_string(pmeta)
-    if (c_associated(pmeta)) call mpmc_free(pmeta)
-  end function mpmc_sim_checkpoint_read_mpi_f
 
   ! ---- running a stage ------------------------------------------------------------------
 
