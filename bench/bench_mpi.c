@@ -41,7 +41,7 @@
 #include <time.h>
 
 #include "mpmc.h"
-#include "mpmc_impl.h"
+#include "mpmc_bench.h" /* the grid's active box and node size (libmpmc/src, the internal archive) */
 #include "mpmc_mpi.h"
 
 /* ---- counting through the profiling interface ---------------------------------------- */
@@ -209,14 +209,15 @@ static result run(MPI_Comm comm, int centred, int threads, int steps) {
   MPI_Allreduce(&mine, &r.points, 1, MPI_LONG, MPI_SUM, comm);
   MPI_Allreduce(&mine, &r.pmin, 1, MPI_LONG, MPI_MIN, comm);
   MPI_Allreduce(&mine, &r.pmax, 1, MPI_LONG, MPI_MAX, comm);
-  const mpmc_grid *gr = &sim->grid;
+  int alo[3], ahi[3];
+  size_t rec_bytes, node_bytes;
+  CHECK(mpmc_bench_grid(sim, alo, ahi, &rec_bytes, &node_bytes));
   r.area = 1;
   for (int a = 0; a < 3; ++a)
-    if (a != axis) r.area *= gr->act_hi[a] > gr->act_lo[a] ? gr->act_hi[a] - gr->act_lo[a] : 0;
+    if (a != axis) r.area *= ahi[a] > alo[a] ? ahi[a] - alo[a] : 0;
   r.neighbours = (rank > 0) + (rank + 1 < nranks);
-  r.rec_bytes = sizeof(double) * MPMC_NREC +
-                (gr->fb ? 2 * sizeof(double) : gr->fbj ? sizeof(double) : 0);
-  r.grid_node_bytes = r.rec_bytes + sizeof *gr->fixed;
+  r.rec_bytes = rec_bytes;
+  r.grid_node_bytes = node_bytes;
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   return r;
@@ -266,6 +267,8 @@ static int ilog2ceil(int n) {
 }
 
 static void model(const result *one, const result *two, int steps) {
+  int ghost, min_cells; /* the grid's ghost cells a side, a slab's fewest cells */
+  mpmc_bench_layout(&ghost, &min_cells);
   /* s per point-step: CPU time, which a loaded machine's waits for a core do not inflate */
   const double tp = one->cpu_max / ((double)one->points * steps);
   const int nb = two->neighbours > 0 ? two->neighbours : 1;
@@ -330,15 +333,15 @@ static void model(const result *one, const result *two, int steps) {
       printf("%-6d %-7s %-17s %5.1f %8.2f %8.2f %7.0f%% %5.0f %8.1f %7.3f %7.3f %6.2f%% %6.2f%% "
              "%7.2f%s\n", P, dname[d], sub, emin, hbytes / 1e6, owned / 1e6, 100 * hbytes / owned,
              mtot, 1e3 * comp, 1e3 * comm[0], 1e3 * comm[1], 100 * eff[0], 100 * eff[1],
-             pow(N + 2 * MPMC_GHOST + 1, 3) * gnode / 1e9,
-             emin < MPMC_DD_MIN_CELLS ? "  thinner than 5 cells" : "");
+             pow(N + 2 * ghost + 1, 3) * gnode / 1e9,
+             emin < min_cells ? "  thinner than 5 cells" : "");
     }
   }
   printf("(min: the thinnest cut extent in cells, against the slabs' minimum of %d; halo/own: the "
          "halo bytes a rank sends per step over its owned grid's bytes; msgs: messages sent per "
          "step; comm A, B: ms per step; grid GB: what every rank allocates today, the global "
          "grid)\n",
-         MPMC_DD_MIN_CELLS);
+         min_cells);
   /* a slab w cells thick sends 2 x barea per node of its cross-section and owns w x gnode */
   const double w10 = ceil(20.0 * barea / gnode), w3 = ceil(20.0 * 3.0 * two->rec_bytes / gnode);
   printf("slabs: halo/own = 2 x %.0f B / (w x %.0f B) whatever the cross-section: <= 10 %% needs "

@@ -2,6 +2,20 @@
 #include "mpmc_bench.h"
 #include "mpmc_impl.h"
 
+int mpmc_bench_grid(mpmc_sim sim, int lo[3], int hi[3], size_t *record_bytes, size_t *node_bytes) {
+  if (!sim) return MPMC_ERR_ARG;
+  const mpmc_grid *g = &sim->grid;
+  for (int a = 0; a < 3; ++a) lo[a] = g->act_lo[a], hi[a] = g->act_hi[a];
+  *record_bytes = sizeof(double) * MPMC_NREC + (g->fb ? 2 * sizeof(double) : g->fbj ? sizeof(double) : 0);
+  *node_bytes = *record_bytes + sizeof *g->fixed;
+  return MPMC_SUCCESS;
+}
+
+void mpmc_bench_layout(int *ghost_cells, int *min_slab_cells) {
+  *ghost_cells = MPMC_GHOST;
+  *min_slab_cells = MPMC_DD_MIN_CELLS;
+}
+
 double mpmc_bench_bytes_per_point(mpmc_sim sim) {
   if (!sim) return 0.0;
   const mpmc_particles *p = &sim->p;
