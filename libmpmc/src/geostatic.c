@@ -3,23 +3,33 @@
  * horizontal ones K0 times it (in effective stress under a water table for the effective
  * models), and the elastic strain that carries it.  Columns are bins of the points' own
  * spacing over the horizontal axes, so a sloping surface gives each column its own
- * overburden. */
+ * overburden.  Over MPI every rank sees every point once (mpmc_dd_allgather) and sets its own. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "mpmc_impl.h"
 
+/* a point as every rank sees it: the columns and the median spacing are over all points */
+typedef struct {
+  double x[3];   /* position; the last axis is the elevation */
+  double m;      /* mass                                      */
+  double sp;     /* spacing, vol0^(1/d)                       */
+  long long id;  /* global id: ties in elevation              */
+} point;
+
 typedef struct {
   long col;      /* column index over the horizontal axes */
   double z;      /* elevation                              */
-  int q;         /* point                                  */
+  long long id;  /* global id                              */
+  int k;         /* record                                 */
 } entry;
 
 static int by_column_top_down(const void *a, const void *b) {
   const entry *x = a, *y = b;
   if (x->col != y->col) return x->col < y->col ? -1 : 1;
-  return x->z > y->z ? -1 : x->z < y->z ? 1 : x->q - y->q;
+  if (x->z != y->z) return x->z > y->z ? -1 : 1;
+  return x->id < y->id ? -1 : x->id > y->id;
 }
 
 static int by_double(const void *a, const void *b) {
@@ -50,42 +60,66 @@ int mpmc_sim_set_geostatic_stress(mpmc_sim sim, double k0) {
   MPMC_CHECK(g > 0, ctx, MPMC_ERR_ARG,
              "geostatic stress: gravity along %c is %g: set a downward gravity first", "xyz"[v],
              sim->gravity[v]);
-  /* a column's overburden and the median spacing are over points other ranks may hold */
-  MPMC_CHECK(mpmc_dd_ranks(sim) == 1, ctx, MPMC_ERR_UNSUPPORTED,
-             "geostatic stress (initial_stress.k0) is not available over MPI (%d ranks) yet: "
-             "initialise the stresses with a gravity stage instead", mpmc_dd_ranks(sim));
   MPMC_CALL(mpmc_sim_prepare(sim));
   mpmc_particles *p = &sim->p;
   const int n = p->n;
-  if (n == 0) return MPMC_SUCCESS;
-  MPMC_CHECK(p->be, ctx, MPMC_ERR_STATE, "geostatic stress: no soil material (Hencky elasticity)");
-  /* the column width: the median spacing of the points, vol0^(1/d) */
-  double *sp = malloc(sizeof *sp * (size_t)n);
-  entry *e = malloc(sizeof *e * (size_t)n);
-  if (!sp || !e) {
+  /* over MPI a column and the median spacing take in points other ranks hold: every rank
+   * sees every point (once, at initialisation) and sets its own */
+  int err = n > 0 && !p->be ? MPMC_ERROR(ctx, MPMC_ERR_STATE, "geostatic stress: no soil material "
+                                         "(Hencky elasticity)")
+                            : MPMC_SUCCESS;
+  point *mine = malloc(sizeof *mine * (size_t)(n > 0 ? n : 1));
+  if (!err && !mine)
+    err = MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "geostatic stress: out of memory for %d points", n);
+  if ((err = mpmc_dd_agree(sim, err))) {
+    free(mine);
+    return err;
+  }
+  for (int q = 0; q < n; ++q) {
+    point *r = mine + q;
+    for (int a = 0; a < 3; ++a) r->x[a] = a < d ? p->x[(size_t)q * d + a] : 0.0;
+    r->m = p->m[q];
+    r->sp = pow(p->vol0[q], 1.0 / d);
+    r->id = p->id ? p->id[q] : q;
+  }
+  void *every = NULL;
+  int total = 0, off = 0;
+  err = mpmc_dd_allgather(sim, mine, n, sizeof *mine, &every, &total, &off);
+  free(mine);
+  if (err) return err;
+  const point *all = every;
+  double *sp = malloc(sizeof *sp * (size_t)(total > 0 ? total : 1));
+  entry *e = malloc(sizeof *e * (size_t)(total > 0 ? total : 1));
+  err = sp && e ? MPMC_SUCCESS
+                : MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "geostatic stress: out of memory for %d points", total);
+  err = mpmc_dd_agree(sim, err);
+  if (err || total == 0) {
+    free(every);
     free(sp);
     free(e);
-    return MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "geostatic stress: out of memory for %d points", n);
+    return err;
   }
-  for (int q = 0; q < n; ++q) sp[q] = pow(p->vol0[q], 1.0 / d);
-  qsort(sp, (size_t)n, sizeof *sp, by_double);
-  const double w = sp[n / 2], area = d == 3 ? w * w : w;
+  /* the column width: the median spacing of the points */
+  for (int k = 0; k < total; ++k) sp[k] = all[k].sp;
+  qsort(sp, (size_t)total, sizeof *sp, by_double);
+  const double w = sp[total / 2], area = d == 3 ? w * w : w;
   free(sp);
   const mpmc_grid *gr = &sim->grid;
   const long nx = (long)ceil((gr->hi[0] - gr->lo[0]) / w) + 1;
-  for (int q = 0; q < n; ++q) {
-    const double *x = p->x + (size_t)q * d;
+  for (int k = 0; k < total; ++k) {
+    const double *x = all[k].x;
     long col = (long)floor((x[0] - gr->lo[0]) / w);
     if (d == 3) col += nx * (long)floor((x[1] - gr->lo[1]) / w);
-    e[q] = (entry){col, x[v], q};
+    e[k] = (entry){col, x[v], all[k].id, k};
   }
-  qsort(e, (size_t)n, sizeof *e, by_column_top_down);
+  qsort(e, (size_t)total, sizeof *e, by_column_top_down);
   double above = 0.0; /* mass above in the current column */
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < total; ++k) {
     if (k == 0 || e[k].col != e[k - 1].col) above = 0.0;
-    const int q = e[k].q;
-    const double sv = -g * (above + 0.5 * p->m[q]) / area; /* total, compression < 0 */
-    above += p->m[q];
+    const double mk = all[e[k].k].m, sv = -g * (above + 0.5 * mk) / area; /* total, compression < 0 */
+    above += mk;
+    const int q = e[k].k - off; /* this rank's point, or another's */
+    if (q < 0 || q >= n) continue;
     const mpmc_material *m = &sim->mats[p->mat[q]];
     if (!(m->model->flags & MPMC_MODEL_HENCKY)) continue;
     const double pw = p->pw && (m->model->flags & MPMC_MODEL_EFFECTIVE) ? p->pw[q] : 0.0;
@@ -105,5 +139,6 @@ int mpmc_sim_set_geostatic_stress(mpmc_sim sim, double k0) {
     if (d == 2) be[2] = 1.0; /* no elastic out-of-plane strain: sigma_zz = nu (sigma_xx + sigma_yy) */
   }
   free(e);
+  free(every);
   return MPMC_SUCCESS;
 }

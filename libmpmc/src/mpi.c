@@ -941,3 +941,51 @@ int mpmc_dd_balance_due(struct mpmc_sim_s *sim) {
 }
 
 #endif /* MPMC_HAVE_MPI */
+
+/* ---- every rank's records ------------------------------------------------------------ */
+
+int mpmc_dd_allgather(struct mpmc_sim_s *sim, const void *mine, int n, size_t size, void **all,
+                      int *total, int *offset) {
+  *all = NULL;
+  *total = n;
+  *offset = 0;
+#ifdef MPMC_HAVE_MPI
+  struct mpmc_dd_s *dd = sim->dd;
+  if (dd) {
+    int *count = malloc(sizeof *count * 2 * (size_t)dd->size), err = MPMC_SUCCESS;
+    if (!count)
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the counts of %d ranks", dd->size);
+    MPMC_CALL(mpmc_dd_agree(sim, err)); /* every rank has its counts, or none goes on */
+    MPI_Allgather(&n, 1, MPI_INT, count, 1, MPI_INT, dd->comm);
+    long long sum = 0;
+    for (int r = 0; r < dd->size; ++r) {
+      count[dd->size + r] = (int)sum; /* displacement, in records */
+      if (r == dd->rank) *offset = (int)sum;
+      sum += count[r];
+    }
+    if (sum > INT_MAX)
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_ARG, "%lld points over the ranks: more than %d", sum, INT_MAX);
+    else if (!(*all = malloc(size * (size_t)(sum > 0 ? sum : 1))))
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %lld records of %zu bytes", sum, size);
+    err = mpmc_dd_agree(sim, err);
+    if (err) {
+      free(count);
+      free(*all);
+      *all = NULL;
+      return err;
+    }
+    MPI_Datatype rec;
+    MPI_Type_contiguous((int)size, MPI_BYTE, &rec);
+    MPI_Type_commit(&rec);
+    MPI_Allgatherv(mine, n, rec, *all, count, count + dd->size, rec, dd->comm);
+    MPI_Type_free(&rec);
+    *total = (int)sum;
+    free(count);
+    return MPMC_SUCCESS;
+  }
+#endif
+  MPMC_CHECK(*all = malloc(size * (size_t)(n > 0 ? n : 1)), sim->ctx, MPMC_ERR_MEMORY,
+             "cannot allocate %d records of %zu bytes", n, size);
+  if (n > 0) memcpy(*all, mine, size * (size_t)n);
+  return MPMC_SUCCESS;
+}

@@ -610,6 +610,10 @@ int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v);
 /* the least v over the ranks and, of the ranks that have it, the least id (collective);
  * without any: v = +inf and id = -1 */
 void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id);
+/* every rank's n records of size bytes, in rank order, into *all (malloc'ed; the caller
+ * frees it): *total records, this rank's from *offset (collective; one process: a copy) */
+int mpmc_dd_allgather(struct mpmc_sim_s *sim, const void *mine, int n, size_t size, void **all,
+                      int *total, int *offset);
 /* the number of ranks (1 in one process) */
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim);
 void mpmc_dd_free(struct mpmc_sim_s *sim);

@@ -2,7 +2,8 @@
  * local damping) for 100 steps over MPI against the same run in one process, point by point
  * by global id, for every basis and every F-bar form (the halo sums of mass, momentum, force
  * and F-bar's nodal volumes across the slab boundaries); and once in a grid twice as tall,
- * where the upper ranks' slabs hold no point.  Run with 2 and 3 ranks (tests/mpi.cmake).
+ * where the upper ranks' slabs hold no point; and once from the geostatic state
+ * (mpmc_sim_set_geostatic_stress, K0 = 0.5), whose columns cross every slab.  Run with 2 and 3 ranks (tests/mpi.cmake).
  * Tolerance: the largest difference of each field (positions, velocities, stresses) at most
  * 1e-12 of its largest magnitude, or, where the run in one process is itself that sensitive
  * to the order of its sums, 3 x what it changes by when only the order of its points is
@@ -18,7 +19,7 @@ static const char *fbar_name[5] = {"off", "paper", "total", "stable", "anchored"
 
 /* The column of height H in a grid of height Hg, on comm or (MPI_COMM_NULL) alone; STEPS
  * steps of dt; the points' records into out (rank 0). */
-static void column(MPI_Comm comm, int basis, int fbar, double Hg, double dt, int reverse,
+static void column(MPI_Comm comm, int basis, int fbar, double Hg, double k0, double dt, int reverse,
                    int *ntotal, double *out) {
   const double H = 10.0, W = 1.0, h = 0.5, rho = 2000.0, E = 10e6, nu = 0.3, g = 9.81;
   mpmc_context ctx;
@@ -49,6 +50,7 @@ static void column(MPI_Comm comm, int basis, int fbar, double Hg, double dt, int
   MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
   MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
   MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  if (k0 > 0) MCALL(ctx, mpmc_sim_set_geostatic_stress(sim, k0));
   for (int s = 0; s < STEPS; ++s) MCALL(ctx, mpmc_sim_step(sim, dt));
   *ntotal = n;
   test_gather(ctx, sim, 2, n, comm != MPI_COMM_NULL, out);
@@ -66,18 +68,18 @@ static void column(MPI_Comm comm, int basis, int fbar, double Hg, double dt, int
 }
 
 /* One case on MPI_COMM_WORLD against rank 0's run alone; 1 if it failed. */
-static int check(int basis, int fbar, double Hg, double *worst) {
+static int check(int basis, int fbar, double Hg, double k0, double *worst) {
   const double dt = 1e-4; /* below 0.3 h / c for E = 10 MPa, nu = 0.3 */
   const int nmax = 4 * 2 * 20 * 2;
   double *par = test_rank == 0 ? malloc(sizeof(double) * nmax * TEST_REC(2)) : NULL;
   double *ser = test_rank == 0 ? malloc(sizeof(double) * nmax * TEST_REC(2)) : NULL;
   double *rev = test_rank == 0 ? malloc(sizeof(double) * nmax * TEST_REC(2)) : NULL;
   int n = 0;
-  column(MPI_COMM_WORLD, basis, fbar, Hg, dt, 0, &n, par);
+  column(MPI_COMM_WORLD, basis, fbar, Hg, k0, dt, 0, &n, par);
   int bad = 0;
   if (test_rank == 0) {
-    column(MPI_COMM_NULL, basis, fbar, Hg, dt, 0, &n, ser);
-    column(MPI_COMM_NULL, basis, fbar, Hg, dt, 1, &n, rev);
+    column(MPI_COMM_NULL, basis, fbar, Hg, k0, dt, 0, &n, ser);
+    column(MPI_COMM_NULL, basis, fbar, Hg, k0, dt, 1, &n, rev);
     double rel[3], band[3], tol[3];
     test_compare(2, n, par, ser, rel);
     test_compare(2, n, rev, ser, band);
@@ -87,10 +89,10 @@ static int check(int basis, int fbar, double Hg, double *worst) {
       worst[f] = fmax(worst[f], rel[f]);
     }
     if (bad || test_verbose())
-      printf("column %-8s F-bar %-8s grid height %4.1f on %d ranks: max |difference| / max "
+      printf("column %-8s F-bar %-8s grid height %4.1f K0 %.2f on %d ranks: max |difference| / max "
              "|value| against one process: position %.2g, velocity %.2g, stress %.2g (one "
              "process, points reversed: %.2g, %.2g, %.2g)%s\n",
-             basis_name[basis], fbar_name[fbar], Hg, test_size, rel[0], rel[1], rel[2], band[0],
+             basis_name[basis], fbar_name[fbar], Hg, k0, test_size, rel[0], rel[1], rel[2], band[0],
              band[1], band[2], bad ? "  <- expected at most max(1e-12, 3 x the latter)" : "");
   }
   free(rev);
@@ -104,9 +106,11 @@ int main(int argc, char **argv) {
   test_init(&argc, &argv);
   double worst[3] = {0, 0, 0};
   for (int b = 0; b < 4; ++b)
-    for (int f = 0; f <= 4; ++f) test_failed |= check(b, f, 11.0, worst);
+    for (int f = 0; f <= 4; ++f) test_failed |= check(b, f, 11.0, 0.0, worst);
   /* twice as tall: the top ranks' slabs are empty at first */
-  test_failed |= check(2, 4, 22.0, worst);
+  test_failed |= check(2, 4, 22.0, 0.0, worst);
+  /* the geostatic state at once: each column's overburden summed over the ranks' points */
+  test_failed |= check(2, 4, 11.0, 0.5, worst);
   if (test_rank == 0 && test_verbose())
     printf("t701 on %d ranks: worst over the cases: position %.3g, velocity %.3g, stress %.3g\n",
            test_size, worst[0], worst[1], worst[2]);
