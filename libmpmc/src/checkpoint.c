@@ -163,9 +163,8 @@ static double *adaptive_nodes(const mpmc_sim sim) {
   double *a = malloc(sim->adr_nf * sizeof *a);
   if (!a) return NULL;
   const int ax = sim->adr_own[0], w = 1 + sim->dim;
-  const long n0 = sim->grid.n[0], n1 = sim->grid.n[1];
   for (size_t i = 0; i < sim->grid.nn; ++i) {
-    const long k = ax == 0 ? (long)i % n0 : ax == 1 ? (long)i / n0 % n1 : (long)i / (n0 * n1);
+    const long k = mpmc_grid_plane(&sim->grid, ax, i);
     const int mine = k >= sim->adr_own[1] && k < sim->adr_own[2];
     for (int c = 0; c < w; ++c) a[i * (size_t)w + c] = mine ? sim->adr_f[i * (size_t)w + c] : 0.0;
   }

@@ -23,7 +23,7 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   double *restrict fprev = sim->adr_f;
   double *restrict rowsum = sim->adr_rows;
   const int oax = adr ? sim->adr_own[0] : -1; /* MPI: the nodes this rank sums (damping.c) */
-  const long olo = sim->adr_own[1], ohi = sim->adr_own[2], n0 = g->n[0], n1 = g->n[1];
+  const long olo = sim->adr_own[1], ohi = sim->adr_own[2];
 #pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long row = 0; row < nrow; ++row) {
     size_t len;
@@ -46,7 +46,7 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
         double *restrict fp = fprev + i * (size_t)(1 + DIM);
         int both = fp[0] == stamp - 1.0;
         if (oax >= 0) {
-          const long k = oax == 0 ? (long)i % n0 : oax == 1 ? (long)i / n0 % n1 : (long)i / (n0 * n1);
+          const long k = mpmc_grid_plane(g, oax, i);
           both &= k >= olo && k < ohi;
         }
         for (int a = 0; a < DIM; ++a) {

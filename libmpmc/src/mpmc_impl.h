@@ -193,6 +193,11 @@ static inline long mpmc_grid_active_rows(const mpmc_grid *g) {
   const long ny = g->act_hi[1] - g->act_lo[1], nz = g->act_hi[2] - g->act_lo[2];
   return g->act_hi[0] > g->act_lo[0] && ny > 0 && nz > 0 ? ny * nz : 0;
 }
+/* node i's plane along axis a (its index j, k or l) */
+static inline long mpmc_grid_plane(const mpmc_grid *g, int a, size_t i) {
+  const long n0 = g->n[0], n1 = g->n[1], l = (long)i;
+  return a == 0 ? l % n0 : a == 1 ? l / n0 % n1 : l / (n0 * n1);
+}
 /* the grid row (j, k) index j + n1 k of the active box's row r */
 static inline size_t mpmc_grid_row_index(const mpmc_grid *g, long r) {
   const long ny = g->act_hi[1] - g->act_lo[1];
