@@ -11,7 +11,9 @@
  * verdict) goes through wf_all_*: in one process the library's arrays as they are; over
  * MPI every rank's points gathered on every rank and put in the order of their global ids,
  * so that each rank computes the same metrics, to the bit, whatever the number of ranks.
- * A gather costs O(all points) per call: it is done per series row and plot, not per step. */
+ * A gather costs O(all points) per call: it is done per series row and plot, not per step;
+ * the points' order by global id is kept between steps (order_update). */
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,6 +25,8 @@
 
 #ifdef MPMC_HAVE_MPI
 #include "mpmc_mpi.h"
+
+static void order_forget(void); /* the gathered points' order (below) */
 
 static int distributed(void) {
   static int known = 0, yes = 0;
@@ -77,10 +81,12 @@ long wf_par_total(long v) {
 }
 
 int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
+  order_forget();
   return distributed() ? mpmc_sim_create_mpi(ctx, MPI_COMM_WORLD, dim, sim) : mpmc_sim_create(ctx, dim, sim);
 }
 
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta) {
+  order_forget();
   return distributed() ? mpmc_sim_checkpoint_read_mpi(ctx, MPI_COMM_WORLD, path, sim, meta)
                        : mpmc_sim_checkpoint_read(ctx, path, sim, meta);
 }
@@ -124,60 +130,104 @@ static void *grow(slot *s, size_t bytes) {
   return s->buf;
 }
 
-/* Every rank's n local items of `width` values (MPI type t, `size` bytes each) gathered on
- * every rank in the order of the points' global ids, into slot s.  *total: the points. */
-static int gather(mpmc_sim sim, const void *local, int *width_io, MPI_Datatype t, size_t size, slot *s, int *total) {
-  int width = *width_io;
-  int n = 0, size_w;
+/* The order of the gathered points, kept while they stay where they are: every rank's
+ * count and offset, and src[j], the gathered row of the point with the j-th smallest global
+ * id.  Valid for one simulation between its steps (a step may migrate, sort or balance
+ * points) while no rank's points change in number or order; a new simulation forgets it. */
+static struct {
+  mpmc_sim sim;
+  int64_t steps;
+  int n;          /* this rank's points when made          */
+  uint64_t hash;  /* of their ids in their order           */
+  int size;       /* ranks                                 */
+  int *counts;    /* [2 size]: counts, then displacements  */
+  long all;       /* points over the ranks                 */
+  long *src;      /* [all]                                 */
+} order;
+
+static void order_forget(void) { order.sim = NULL; }
+
+/* (Re)make the order if any rank finds it stale (collective).  *width_io: every rank's
+ * largest width (a rank without points may not hold the array). */
+static int order_update(mpmc_sim sim, int *width_io) {
+  int n = 0;
   const int *ids = NULL;
+  mpmc_stats st;
   mpmc_sim_get_num_particles(sim, &n);
-  if (n > 0 && mpmc_sim_get_particle_ids(sim, &ids)) n = -1;
-  /* every rank's width (a rank without points may not hold the array) */
-  int wmax = width;
-  MPI_Allreduce(&width, &wmax, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  width = *width_io = wmax;
-  if (wf_par_agree(n < 0 ? MPMC_ERR_STATE : 0)) return MPMC_ERR_STATE;
-  MPI_Comm_size(MPI_COMM_WORLD, &size_w);
-  int *counts = malloc(sizeof(int) * (size_t)size_w * 2);
-  if (!counts) return MPMC_ERR_MEMORY;
-  int *displs = counts + size_w;
+  int bad = mpmc_sim_get_stats(sim, &st) || (n > 0 && mpmc_sim_get_particle_ids(sim, &ids));
+  uint64_t hash = 0; /* a sort or any reordering outside a step changes it */
+  for (int q = 0; q < n && ids; ++q) hash = hash * 1000003u + (uint64_t)(unsigned)ids[q];
+  const int stale = order.sim != sim || order.steps != st.steps || order.n != n || order.hash != hash;
+  int mine[3] = {*width_io, stale, bad}, any[3];
+  MPI_Allreduce(mine, any, 3, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  *width_io = any[0];
+  if (any[2]) return MPMC_ERR_STATE;
+  if (!any[1]) return MPMC_SUCCESS;
+  order_forget();
+  MPI_Comm_size(MPI_COMM_WORLD, &order.size);
+  int *counts = realloc(order.counts, sizeof(int) * (size_t)order.size * 2);
+  bad = !counts;
+  if (counts) order.counts = counts;
+  if (wf_par_agree(bad ? MPMC_ERR_MEMORY : 0)) return MPMC_ERR_MEMORY;
+  int *displs = counts + order.size;
   MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, MPI_COMM_WORLD);
   long all = 0;
-  for (int r = 0; r < size_w; ++r) {
+  for (int r = 0; r < order.size; ++r) {
     displs[r] = (int)all;
     all += counts[r];
   }
   int *gid = malloc(sizeof(int) * (size_t)(all + 1));
-  char *vals = malloc(size * (size_t)width * (size_t)(all + 1));
-  int err = !gid || !vals ? MPMC_ERR_MEMORY : 0;
-  if (!err) {
-    MPI_Allgatherv(ids, n, MPI_INT, gid, counts, displs, MPI_INT, MPI_COMM_WORLD);
-    for (int r = 0; r < size_w; ++r) {
-      counts[r] *= width;
-      displs[r] *= width;
-    }
-    MPI_Allgatherv(local, n * width, t, vals, counts, displs, t, MPI_COMM_WORLD);
-    int top = -1; /* ids are unique; order them by a table over [0, largest id] */
-    for (long k = 0; k < all; ++k) top = gid[k] > top ? gid[k] : top;
-    long *at = malloc(sizeof(long) * (size_t)(top + 2));
-    char *out = grow(s, size * (size_t)width * (size_t)(all + 1));
-    if (!at || !out)
-      err = MPMC_ERR_MEMORY;
-    else {
-      for (long k = 0; k <= top; ++k) at[k] = -1;
-      for (long k = 0; k < all; ++k) at[gid[k]] = k;
-      long j = 0;
-      for (long k = 0; k <= top; ++k)
-        if (at[k] >= 0) memcpy(out + size * (size_t)width * (size_t)j++, vals + size * (size_t)width * (size_t)at[k],
-                               size * (size_t)width);
-      *total = (int)all;
-    }
-    free(at);
+  long *src = realloc(order.src, sizeof(long) * (size_t)(all + 1));
+  if (src) order.src = src;
+  if (wf_par_agree(!gid || !src ? MPMC_ERR_MEMORY : 0)) {
+    free(gid);
+    return MPMC_ERR_MEMORY;
+  }
+  MPI_Allgatherv(ids, n, MPI_INT, gid, counts, displs, MPI_INT, MPI_COMM_WORLD);
+  int top = -1; /* ids are unique; order them by a table over [0, largest id] */
+  for (long k = 0; k < all; ++k) top = gid[k] > top ? gid[k] : top;
+  long *at = malloc(sizeof(long) * (size_t)(top + 2));
+  if (at) {
+    for (long k = 0; k <= top; ++k) at[k] = -1;
+    for (long k = 0; k < all; ++k) at[gid[k]] = k;
+    long j = 0;
+    for (long k = 0; k <= top; ++k)
+      if (at[k] >= 0) src[j++] = at[k];
   }
   free(gid);
-  free(vals);
+  free(at);
+  if (wf_par_agree(at ? 0 : MPMC_ERR_MEMORY)) return MPMC_ERR_MEMORY;
+  order.sim = sim;
+  order.steps = st.steps;
+  order.n = n;
+  order.hash = hash;
+  order.all = all;
+  return MPMC_SUCCESS;
+}
+
+/* Every rank's n local items of `width` values (MPI type t, `size` bytes each) gathered on
+ * every rank in the order of the points' global ids, into slot s.  *total: the points. */
+static int gather(mpmc_sim sim, const void *local, int *width_io, MPI_Datatype t, size_t size, slot *s, int *total) {
+  int err = order_update(sim, width_io);
+  if (err) return err;
+  const int width = *width_io, nr = order.size;
+  const long all = order.all;
+  int *counts = malloc(sizeof(int) * (size_t)nr * 2);
+  char *vals = malloc(size * (size_t)width * (size_t)(all + 1));
+  char *out = grow(s, size * (size_t)width * (size_t)(all + 1));
+  if ((err = wf_par_agree(!counts || !vals || !out ? MPMC_ERR_MEMORY : 0))) {
+    free(counts);
+    free(vals);
+    return err;
+  }
+  for (int r = 0; r < 2 * nr; ++r) counts[r] = order.counts[r] * width;
+  MPI_Allgatherv(local, order.n * width, t, vals, counts, counts + nr, t, MPI_COMM_WORLD);
+  const size_t row = size * (size_t)width;
+  for (long j = 0; j < all; ++j) memcpy(out + row * (size_t)j, vals + row * (size_t)order.src[j], row);
+  *total = (int)all;
   free(counts);
-  return err;
+  free(vals);
+  return MPMC_SUCCESS;
 }
 
 int wf_all_count(mpmc_sim sim, int *n) {
@@ -245,6 +295,9 @@ void wf_all_release(void) {
     slots[k].buf = NULL;
     slots[k].cap = 0;
   }
+  free(order.counts);
+  free(order.src);
+  memset(&order, 0, sizeof order);
 }
 
 #else /* one process: the library's arrays as they are */
