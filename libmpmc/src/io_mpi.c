@@ -15,12 +15,8 @@
 #error "an MPI build needs the parallel HDF5 (CMakeLists.txt: HDF5_PREFER_PARALLEL)"
 #endif
 
-/* The simulation's communicator.  mpi.c's struct mpmc_dd_s begins with it, and a pointer to
- * a structure, converted, points to its first member (C17 6.7.2.1): the decomposition's
- * duplicate of the caller's communicator, whose group and order the files follow. */
-static MPI_Comm comm_of(const struct mpmc_sim_s *sim) {
-  return *(const MPI_Comm *)(const void *)sim->dd;
-}
+/* The simulation's communicator (mpi.c's decomposition holds it). */
+static MPI_Comm comm_of(const struct mpmc_sim_s *sim) { return *(const MPI_Comm *)mpmc_dd_comm(sim); }
 
 void mpmc_io_ranks(const struct mpmc_sim_s *sim, int *rank, int *size) {
   *rank = 0;

@@ -59,6 +59,7 @@ int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) { return (void)sim, (v
 void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id) { (void)sim, (void)v, (void)id; }
 void mpmc_dd_free(struct mpmc_sim_s *sim) { (void)sim; }
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return (void)sim, 1; }
+const void *mpmc_dd_comm(const struct mpmc_sim_s *sim) { return (void)sim, NULL; }
 
 #else /* MPMC_HAVE_MPI */
 
@@ -169,6 +170,7 @@ static void count_sent(double *bytes, long *msgs, int to, size_t n, size_t size)
 }
 
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim) { return sim->dd ? sim->dd->size : 1; }
+const void *mpmc_dd_comm(const struct mpmc_sim_s *sim) { return sim->dd ? &sim->dd->comm : NULL; }
 
 void mpmc_dd_free(struct mpmc_sim_s *sim) {
   struct mpmc_dd_s *dd = sim->dd;

@@ -621,6 +621,8 @@ int mpmc_dd_allgather(struct mpmc_sim_s *sim, const void *mine, int n, size_t si
                       int *total, int *offset);
 /* the number of ranks (1 in one process) */
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim);
+/* the decomposition's communicator (an MPI_Comm; NULL in one process) */
+const void *mpmc_dd_comm(const struct mpmc_sim_s *sim);
 void mpmc_dd_free(struct mpmc_sim_s *sim);
 
 #endif
