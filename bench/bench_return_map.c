@@ -18,8 +18,9 @@
  * residual, the same eta), on a slope-like mix (80 % never yielded at 20-90 % of the
  * strength, 20 % on the surface with eps_p in [0, 2]; increments 1e-4) and on an all-plastic
  * set (trial states plastic for both models); the rows give ns per point of J2's point update
- * (series path), the frictional update (mpmc_mc_update) and its eigen path alone
- * (mpmc_mc_return_map_eig), and the ratio to J2. */
+ * (series path), the frictional update (mpmc_mc_update), the same four points at a time
+ * (mpmc_mc_update4, the material's blocks) and its eigen path alone (mpmc_mc_return_map_eig),
+ * and the ratios to J2. */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -364,7 +365,8 @@ static int ll_states(const mpmc_mc_param *m, int set, mpmc_rm_ws *ws) {
   return 0;
 }
 
-/* best of 10 runs, ns per point: path 0 J2, 1 the frictional update, 2 its eigen path */
+/* best of 10 runs, ns per point: path 0 J2, 1 the frictional update, 2 its eigen path,
+ * 3 the frictional update four points at a time (mpmc_mc_update4, the material's blocks) */
 static double ll_time(mpmc_rm_ws *ws, const mpmc_mc_param *m, int path, long *plastic) {
   mpmc_mc_pre pre;
   mpmc_mc_prepare(m, &pre);
@@ -373,7 +375,24 @@ static double ll_time(mpmc_rm_ws *ws, const mpmc_mc_param *m, int path, long *pl
   for (int r = 0; r < 10; ++r) {
     long np = 0;
     const double t0 = now();
-    for (int i = 0; i < NS; ++i) {
+    if (path == 3)
+      for (int i = 0; i < NS; i += 4) { /* NS is a multiple of 4 */
+        double be[4][6], ep[4], tau[4][6], J[4];
+        mpmc_mc_info info[4];
+        int err[4];
+        memcpy(be, ll_be[i], sizeof be);
+        memcpy(ep, ll_ep + i, sizeof ep);
+        mpmc_mc_update4(ws, MPMC_SOLVER_AUTO, &pre, 4, ll_F + i, be, ep, tau, J, info, err);
+        for (int l = 0; l < 4; ++l) {
+          if (err[l]) {
+            fprintf(stderr, "like for like, blocks, point %d: error %d\n", i + l, err[l]);
+            return NAN;
+          }
+          np += info[l].plastic;
+          sink += tau[l][0];
+        }
+      }
+    for (int i = 0; i < NS && path != 3; ++i) {
       double be[6], ep = ll_ep[i], tau[6], J;
       memcpy(be, ll_be[i], sizeof be);
       int err, pl;
@@ -404,8 +423,8 @@ static double ll_time(mpmc_rm_ws *ws, const mpmc_mc_param *m, int path, long *pl
 static int timing_like(void) {
   mpmc_rm_ws *ws;
   if (mpmc_rm_ws_create(&ws)) return 1;
-  printf("| states | model | ns / point J2 | ns / point model | ratio | eigen path alone | plastic J2 / model |\n");
-  printf("|---|---|---:|---:|---:|---:|---:|\n");
+  printf("| states | model | ns / point J2 | ns / point model | ratio | blocks of 4 | ratio | eigen path alone | plastic J2 / model |\n");
+  printf("|---|---|---:|---:|---:|---:|---:|---:|---:|\n");
   const char *sets[2] = {"slope mix", "all plastic"};
   const struct {
     const char *label;
@@ -423,11 +442,12 @@ static int timing_like(void) {
         fprintf(stderr, "like for like: no plastic states\n");
         return 2;
       }
-      long pj, pm, pe;
+      long pj, pm, pe, pb;
       const double tj = ll_time(ws, &m, 0, &pj), tm = ll_time(ws, &m, 1, &pm), te = ll_time(ws, &m, 2, &pe);
-      if (!(isfinite(tj) && isfinite(tm) && isfinite(te))) return 3;
-      printf("| %s | %s | %.0f | %.0f | %.2f | %.0f | %ld / %ld of %d |\n", sets[set], models[k].label, tj,
-             tm, tm / tj, te, pj, pm, NS);
+      const double tb = ll_time(ws, &m, 3, &pb);
+      if (!(isfinite(tj) && isfinite(tm) && isfinite(te) && isfinite(tb)) || pb != pm) return 3;
+      printf("| %s | %s | %.0f | %.0f | %.2f | %.0f | %.2f | %.0f | %ld / %ld of %d |\n", sets[set],
+             models[k].label, tj, tm, tm / tj, tb, tb / tj, te, pj, pm, NS);
     }
   mpmc_rm_ws_destroy(&ws);
   return 0;

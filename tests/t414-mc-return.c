@@ -3,7 +3,8 @@
  * here by hand (perfect plasticity), the yield conditions after random returns, the three
  * Drucker-Prager matchings against Mohr-Coulomb's strengths, the apexes, newton vs kinsol vs
  * auto on random softening states and on steep softening, objectivity, strength reduction,
- * the eigen-free elastic check against the eigen path, and three element tests at the
+ * the eigen-free elastic check against the eigen path, the update of four points at once
+ * against the point update (bit for bit), and three element tests at the
  * tensor level: drained triaxial compression and plane-strain biaxial compression (peak and
  * residual strength) and simple shear (volume change from the dilation angle). */
 #include <float.h>
@@ -543,6 +544,81 @@ static void test_fast_vs_eig(void **state) {
   if (nel < 1500 || npl < 1500) fail_msg("only %d elastic and %d plastic cases", nel, npl);
 }
 
+/* ---- four points at once (mpmc_mc_update4) against mpmc_mc_update per point ------------ */
+/* the same results (== : the sign of a zero may differ), errors, regions and statistics, on
+ * blocks of mixed points: elastic and plastic, softening and perfect, every surface, strains
+ * beyond the series, diagonal and plane-strain b_e (the closed form's special cases and
+ * zero shear components), a negative eps_p (an error) and partial blocks */
+static void test_blocks(void **state) {
+  (void)state;
+  int nel = 0, npl = 0, nbig = 0;
+  for (int k = 0; k < 3000; ++k) {
+    mpmc_mc_param m;
+    double s0[3], ep0;
+    random_case(&m, s0, &ep0, k % 3 == 0, 50.0);
+    mpmc_mc_pre pre;
+    mpmc_mc_prepare(&m, &pre);
+    const int n = k % 7 == 6 ? 1 + k % 3 : 4;
+    double F[4][3][3], be[4][6], be1[4][6], ep[4], ep1[4], tau[4][6], tau1[4][6], J[4], J1[4];
+    mpmc_mc_info info[4], info1[4];
+    int err[4];
+    for (int l = 0; l < n; ++l) {
+      double s[3], e[3], lam[3], Q[3][3];
+      const double p = m.c_p * (urand() < 0.8 ? -loguni(0.01, 100.0) : 2 * urand());
+      const double q = m.c_p * loguni(0.1, 30.0);
+      double d[3] = {2 * urand() - 1, 2 * urand() - 1, 0};
+      d[2] = -d[0] - d[1];
+      const double nd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (int a = 0; a < 3; ++a) s[a] = l == 0 ? s0[a] : p + q * d[a] / nd;
+      if ((k + l) % 2) /* towards the hydrostatic axis below the apex: mostly elastic */
+        for (int a = 0; a < 3; ++a) s[a] = -m.c_p + 0.1 * (s[a] + m.c_p);
+      strain_of(&m, s, e);
+      const int kind = (int)(10 * urand());
+      if (kind == 0) /* beyond the series: the Jacobi path */
+        for (int a = 0; a < 3; ++a) e[a] += 0.2 * (a - 1.0);
+      for (int a = 0; a < 3; ++a) lam[a] = exp(2 * e[a]);
+      rand_rotation(Q);
+      if (kind == 1 || kind == 2) /* diagonal, or a rotation in the x-y plane */
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (kind == 1 || i == 2 || j == 2) Q[i][j] = (i == j);
+      mpmc_sym3_compose(lam, Q, be[l]);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          F[l][i][j] = (i == j) + (kind == 1 || (kind == 2 && (i == 2 || j == 2))
+                                        ? 0.0 : 1e-4 * (2 * urand() - 1));
+      ep[l] = l == 0 ? ep0 : urand() < 0.3 ? 0.0 : loguni(1e-6, 0.5);
+      if (kind == 3 && urand() < 0.1) ep[l] = -1.0;
+      nbig += kind == 0;
+    }
+    memcpy(be1, be, sizeof be);
+    memcpy(ep1, ep, sizeof ep);
+    mpmc_mc_update4(ws, MPMC_SOLVER_AUTO, &pre, n, F, be, ep, tau, J, info, err);
+    for (int l = 0; l < n; ++l) {
+      const int err1 = mpmc_mc_update(ws, MPMC_SOLVER_AUTO, &pre, F[l], be1[l], &ep1[l], tau1[l],
+                                      &J1[l], &info1[l]);
+      if (err[l] != err1) fail_msg("block %d lane %d: error %d, point update %d", k, l, err[l], err1);
+      if (err1) continue;
+      if (info[l].plastic != info1[l].plastic || info[l].region != info1[l].region ||
+          info[l].fallback != info1[l].fallback || info[l].newton_iters != info1[l].newton_iters)
+        fail_msg("block %d lane %d: plastic %d region %d, point update plastic %d region %d", k,
+                 l, info[l].plastic, info[l].region, info1[l].plastic, info1[l].region);
+      for (int c = 0; c < 6; ++c)
+        if (!(tau[l][c] == tau1[l][c] && be[l][c] == be1[l][c]))
+          fail_msg("block %d lane %d (plastic %d): tau[%d] = %.17g, b_e = %.17g; point update "
+                   "%.17g, %.17g", k, l, info1[l].plastic, c, tau[l][c], be[l][c], tau1[l][c],
+                   be1[l][c]);
+      if (!(ep[l] == ep1[l] && J[l] == J1[l]))
+        fail_msg("block %d lane %d: eps_p %.17g J %.17g, point update %.17g %.17g", k, l, ep[l],
+                 J[l], ep1[l], J1[l]);
+      nel += !info1[l].plastic;
+      npl += info1[l].plastic;
+    }
+  }
+  if (nel < 2000 || npl < 2000 || nbig < 500)
+    fail_msg("only %d elastic, %d plastic, %d large-strain points", nel, npl, nbig);
+}
+
 /* ---- strength reduction ------------------------------------------------------------- */
 static void test_reduce(void **state) {
   (void)state;
@@ -789,6 +865,7 @@ int main(void) {
       cmocka_unit_test(test_reduce),           cmocka_unit_test(test_triaxial),
       cmocka_unit_test(test_simple_shear),     cmocka_unit_test(test_fast_vs_eig),
       cmocka_unit_test(test_biaxial),          cmocka_unit_test(test_apex_cap),
+      cmocka_unit_test(test_blocks),
   };
   return cmocka_run_group_tests(tests, setup, teardown);
 }

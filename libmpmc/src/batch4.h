@@ -165,4 +165,169 @@ static inline void sym_log_series4(const v4 *b, const l4 *am, v4 *eps, l4 *fail)
   MPMC_SYM3_ATANH_HORNER(v4, sym_mul4, z, n, eps);
 }
 
+/* The mask of the lanes set in bits (bit l: lane l), and the bits of a lane-wise condition
+ * evaluated on scalars: on a baseline (SSE2) build GCC lowers the compares of four-lane
+ * vectors to scalar compares, conditional moves and a store and reload of the mask (a
+ * store-forwarding stall per mask); a mask loaded from this table costs one load. */
+static const l4 mpmc_lane_mask[16] = {
+    {0, 0, 0, 0},    {-1, 0, 0, 0},    {0, -1, 0, 0},    {-1, -1, 0, 0},
+    {0, 0, -1, 0},   {-1, 0, -1, 0},   {0, -1, -1, 0},   {-1, -1, -1, 0},
+    {0, 0, 0, -1},   {-1, 0, 0, -1},   {0, -1, 0, -1},   {-1, -1, 0, -1},
+    {0, 0, -1, -1},  {-1, 0, -1, -1},  {0, -1, -1, -1},  {-1, -1, -1, -1}};
+static inline int bits4_of(const int c0, const int c1, const int c2, const int c3) {
+  return (c0 != 0) | (c1 != 0) << 1 | (c2 != 0) << 2 | (c3 != 0) << 3;
+}
+/* the lanes where a > b, a >= b, a != b, a == b (NaN: false but for !=) as masks */
+#define CMP4(a, op, b)                                                                     \
+  mpmc_lane_mask[bits4_of((a)[0] op (b)[0], (a)[1] op (b)[1], (a)[2] op (b)[2],          \
+                          (a)[3] op (b)[3])]
+
+/* sym_log_series4 with each lane at its own degree, so that every lane gets
+ * mpmc_sym3_log_series' bits (the frictional block update, return_mc.c, whose elastic check
+ * and eigen path must decide as the point update does): Horner from the largest lane's top
+ * term, a lane's coefficients 0 above its own top term, so its p stays 0 until there, where
+ * W 0 + c I = c I starts it as the scalar c W + c' I does (the products by 0 add only zeros:
+ * the same bits but for the sign of a zero).  A lane of one term gets Z I = Z.  eps as
+ * sym_log_series4's; fail: the lanes of am whose |Z|^2 is beyond the table or not finite
+ * (their eps is not formed). */
+static inline void sym_log_series4_lanes(const v4 *b, const l4 *am, v4 *eps, l4 *fail) {
+  const double *rho2_max = mpmc_atanh_rho2_max;
+  v4 z[6];
+  MPMC_SYM3_CAYLEY(v4, sym_mul4, b, z);
+  v4 r2;
+  norm2_4(z, &r2);
+  int deg[4], n = 1, fbits = 0;
+  const int abits = mask_bits(am);
+  for (int l = 0; l < 4; ++l) { /* each lane's number of terms, as mpmc_sym3_log_series' */
+    deg[l] = 0;
+    if (!(abits >> l & 1)) continue;
+    if (!(r2[l] <= rho2_max[10])) {
+      fbits |= 1 << l;
+      continue;
+    }
+    int k = 1;
+    while (r2[l] > rho2_max[k]) ++k;
+    deg[l] = k;
+    n = k > n ? k : n;
+  }
+  *fail = mpmc_lane_mask[fbits];
+  if (n == 1) {
+    for (int k = 0; k < 6; ++k) eps[k] = z[k];
+    return;
+  }
+  v4 w[6], p[6];
+  sym_mul4(z, z, w);
+  for (int k = 0; k < 6; ++k) p[k] = (v4){0.0, 0.0, 0.0, 0.0};
+  for (int j = n - 1; j >= 0; --j) {
+    /* c_j in the lanes of degree > j, 0 in the others (a mask from the table: a vector
+     * built from four scalars waits on their stores) */
+    const double cj = mpmc_atanh_c[j];
+    const int live = bits4_of(j < deg[0], j < deg[1], j < deg[2], j < deg[3]);
+    const v4 c = (v4)(mpmc_lane_mask[live] & (l4)(v4){cj, cj, cj, cj});
+    sym_mul4(w, p, p);
+    for (int k = 0; k < 3; ++k) p[k] += c;
+  }
+  sym_mul4(z, p, eps);
+}
+
+/* mpmc_sym3_eig_closed of four symmetric tensors (lanes of s, Voigt), its operations lane by
+ * lane in vectors and its branches as masks, so every lane gets its bits (acos and cos by
+ * libm per lane).  lam[3] the eigenvalues, Q[3 i + a] the eigenvectors' components.  The
+ * lanes of am that take one of its special cases (diagonal, a deviator too small or too
+ * large, not finite) are not formed: *fb, for mpmc_sym3_eig_closed itself. */
+static inline void sym3_eig_closed4(const v4 *s, const l4 *am, v4 *lam, v4 *Q, l4 *fb) {
+  const v4 zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
+  const v4 m = (s[0] + s[1] + s[2]) / 3.0;
+  const v4 B[3][3] = {{s[0] - m, s[5], s[4]}, {s[5], s[1] - m, s[3]}, {s[4], s[3], s[2] - m}};
+  const v4 p2 = (B[0][0] * B[0][0] + B[1][1] * B[1][1] + B[2][2] * B[2][2] +
+                 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])) / 6.0;
+  const v4 tiny = {1e-280, 1e-280, 1e-280, 1e-280}, huge = {1e280, 1e280, 1e280, 1e280};
+  const v4 d2 = p2 - p2, dm = m - m;
+  const l4 diag = CMP4(s[3], ==, zero) & CMP4(s[4], ==, zero) & CMP4(s[5], ==, zero) &
+                  CMP4(d2, ==, zero);
+  l4 ok = *am & ~diag & CMP4(p2, >=, tiny) & CMP4(p2, <=, huge) & CMP4(dm, ==, zero);
+  const v4 p2s = SEL4(ok, p2, one); /* finite dummies in the other lanes */
+  v4 pp;
+  sqrt4(&p2s, &pp);
+  const v4 ip = 1.0 / pp;
+  v4 Bn[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) Bn[i][j] = SEL4(ok, B[i][j] * ip, zero);
+  const v4 r = 0.5 * (Bn[0][0] * (Bn[1][1] * Bn[2][2] - Bn[1][2] * Bn[2][1]) -
+                      Bn[0][1] * (Bn[1][0] * Bn[2][2] - Bn[1][2] * Bn[2][0]) +
+                      Bn[0][2] * (Bn[1][0] * Bn[2][1] - Bn[1][1] * Bn[2][0]));
+  const double pi3 = 1.0471975511965976; /* pi/3 */
+  v4 li = zero;
+  for (int bits = mask_bits(&ok), l = 0; bits; bits >>= 1, ++l) {
+    if (!(bits & 1)) continue;
+    const double rl = r[l];
+    const double phi = acos(rl >= 1.0 ? 1.0 : rl <= -1.0 ? -1.0 : rl) / 3.0;
+    li[l] = phi <= 0.5 * pi3 ? 2.0 * cos(phi) : 2.0 * cos(phi + 2.0 * pi3);
+  }
+  v4 C[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) C[i][j] = i == j ? Bn[i][j] - li : Bn[i][j];
+  v4 x[3][3], n2[3];
+  for (int k = 0; k < 3; ++k) { /* the cross products of rows (0,1), (0,2), (1,2) */
+    const v4 *a = C[k == 2 ? 1 : 0], *b = C[k == 0 ? 1 : 2];
+    x[k][0] = a[1] * b[2] - a[2] * b[1];
+    x[k][1] = a[2] * b[0] - a[0] * b[2];
+    x[k][2] = a[0] * b[1] - a[1] * b[0];
+    n2[k] = x[k][0] * x[k][0] + x[k][1] * x[k][1] + x[k][2] * x[k][2];
+  }
+  const l4 c01 = CMP4(n2[0], >=, n2[1]), c02 = CMP4(n2[0], >=, n2[2]),
+           c12 = CMP4(n2[1], >=, n2[2]);
+  const l4 k0 = c01 & c02, k1 = ~c01 & c12; /* else row pair 2 */
+  v4 xb[3];
+  for (int i = 0; i < 3; ++i) xb[i] = SEL4(k0, x[0][i], SEL4(k1, x[1][i], x[2][i]));
+  const v4 nb = SEL4(k0, n2[0], SEL4(k1, n2[1], n2[2]));
+  ok &= CMP4(nb, >, zero);
+  *fb = *am & ~ok;
+  const v4 nbs = SEL4(ok, nb, one);
+  v4 iv;
+  sqrt4(&nbs, &iv);
+  iv = 1.0 / iv;
+  const v4 v[3] = {xb[0] * iv, xb[1] * iv, xb[2] * iv};
+  /* an orthonormal basis u, w of the complement of v */
+  const v4 av0 = ABS4(v[0]), av1 = ABS4(v[1]);
+  const l4 cu = CMP4(av0, >, av1);
+  v4 den = SEL4(cu, v[0] * v[0] + v[2] * v[2], v[1] * v[1] + v[2] * v[2]), iu;
+  den = SEL4(ok, den, one);
+  sqrt4(&den, &iu);
+  iu = 1.0 / iu;
+  const v4 u[3] = {SEL4(cu, -v[2] * iu, zero), SEL4(cu, zero, v[2] * iu),
+                   SEL4(cu, v[0] * iu, -v[1] * iu)};
+  const v4 w[3] = {v[1] * u[2] - v[2] * u[1], v[2] * u[0] - v[0] * u[2],
+                   v[0] * u[1] - v[1] * u[0]};
+  v4 Bv[3], Bu[3], Bw[3];
+  for (int i = 0; i < 3; ++i) {
+    Bv[i] = B[i][0] * v[0] + B[i][1] * v[1] + B[i][2] * v[2];
+    Bu[i] = B[i][0] * u[0] + B[i][1] * u[1] + B[i][2] * u[2];
+    Bw[i] = B[i][0] * w[0] + B[i][1] * w[1] + B[i][2] * w[2];
+  }
+  const v4 lv = v[0] * Bv[0] + v[1] * Bv[1] + v[2] * Bv[2];
+  const v4 a00 = u[0] * Bu[0] + u[1] * Bu[1] + u[2] * Bu[2];
+  const v4 a11 = w[0] * Bw[0] + w[1] * Bw[1] + w[2] * Bw[2];
+  const v4 a01 = 0.5 * (u[0] * Bw[0] + u[1] * Bw[1] + u[2] * Bw[2] + w[0] * Bu[0] +
+                        w[1] * Bu[1] + w[2] * Bu[2]);
+  /* the rotation of mpmc_sym3_eig where a01 != 0, else c = 1, sn = t = 0 */
+  const l4 nz = ok & CMP4(a01, !=, zero);
+  const v4 a01s = SEL4(nz, a01, one);
+  const v4 theta = (a11 - a00) / (2.0 * a01s);
+  v4 h = theta * theta + 1.0, sh, sc;
+  sqrt4(&h, &sh);
+  const v4 t = SEL4(nz, SEL4(CMP4(theta, >=, zero), one, -one) / (ABS4(theta) + sh), zero);
+  h = t * t + 1.0;
+  sqrt4(&h, &sc);
+  const v4 c = SEL4(nz, 1.0 / sc, one), sn = SEL4(nz, t * c, zero);
+  lam[0] = m + lv;
+  lam[1] = m + (a00 - t * a01);
+  lam[2] = m + (a11 + t * a01);
+  for (int i = 0; i < 3; ++i) {
+    Q[3 * i] = v[i];
+    Q[3 * i + 1] = c * u[i] - sn * w[i];
+    Q[3 * i + 2] = sn * u[i] + c * w[i];
+  }
+}
+
 #endif

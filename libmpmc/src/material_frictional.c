@@ -2,8 +2,11 @@
  * by dF (dF-bar with F-bar on), the return map of return_mc.c (mpmc_mc_update: an elastic
  * check without eigen-decomposition, the principal-space return for the plastic points),
  * then the Cauchy stress tau / J (J-bar with F-bar on).  The material's sines, cosines and
- * cut-off are worked out once per call (mpmc_mc_prepare).  The loop over the points, with the
- * region, the plastic volume ratio, the pore pressure and the counters, is stress_return.c's. */
+ * cut-off are worked out once per call (mpmc_mc_prepare).  Four points of the material in a
+ * block (points 4k .. 4k + 3) go through mpmc_mc_update4 together (their trial states, series
+ * and eigen-decompositions as vectors), each with mpmc_mc_update's results.  The loop over
+ * the points, with the region, the plastic volume ratio, the pore pressure and the counters,
+ * is stress_return.c's. */
 #include <math.h>
 
 #include "material_frictional.h"
@@ -70,6 +73,21 @@ static int frictional_fail(struct mpmc_sim_s *sim, const mpmc_material *mat, int
                     sim->p.eps_p[pt->q], info.dgamma, info.residual, info.kinsol_flag, pt->J);
 }
 
+/* four points' returns (stress_return.h), by mpmc_mc_update4 */
+static void frictional_block(const void *model, mpmc_rm_ws *ws, int solver, double F[4][3][3],
+                             double be[4][6], double eps_p[4], double tau[4][6],
+                             mpmc_return_out out[4], int err[4]) {
+  mpmc_mc_info info[4] = {{0}};
+  double Je[4];
+  mpmc_mc_update4(ws, solver, model, 4, F, be, eps_p, tau, Je, info, err);
+  for (int l = 0; l < 4; ++l) {
+    out[l].Je = Je[l];
+    out[l].plastic = info[l].plastic;
+    out[l].fallback = info[l].fallback;
+    out[l].region = info[l].region;
+  }
+}
+
 static const mpmc_return_ops frictional_ops = {frictional_point, frictional_fail};
 
 int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
@@ -77,5 +95,5 @@ int mpmc_frictional_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int
   const mpmc_mc_param mp = frictional_param(mat, surface);
   mpmc_mc_pre pre;
   mpmc_mc_prepare(&mp, &pre);
-  return mpmc_return_update(sim, mat, id, &frictional_ops, &pre);
+  return mpmc_return_update_blocks(sim, mat, id, &frictional_ops, frictional_block, &pre);
 }

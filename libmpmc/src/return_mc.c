@@ -22,6 +22,7 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include "batch4.h"
 #include "linalg.h"
 #include "return_mc.h"
 
@@ -1087,15 +1088,29 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
  * btr is the trial b_e itself, and the returned b_e's eigenvalues are its own, q_a.b q_a,
  * times exp(2 (eps_a - eps_tr,a)) (a small correction: return_map.h's polynomial; libm's
  * exp beyond it), J likewise sqrt(det b) exp(tr(eps - eps_tr)): four exps less. */
+static int return_decomposed(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
+                             double lam[3], double Q[3][3], const double *btr, double *be,
+                             double *eps_p, double *tau, double *J_out, mpmc_mc_info *info,
+                             const mc_mat *q0);
+
 static int return_eig(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double *b,
                       const double *btr, double *be, double *eps_p, double *tau, double *J_out,
                       mpmc_mc_info *info, const mc_mat *q0) {
-  const int lg = btr != NULL;
-  double lam[3], Q[3][3], etr[3], e[3], t[3];
-  if (lg) /* the update's plastic points: closed form (the Jacobi sweeps cost ~5x the return) */
+  double lam[3], Q[3][3];
+  if (btr) /* the update's plastic points: closed form (the Jacobi sweeps cost ~5x the return) */
     mpmc_sym3_eig_closed(b, lam, Q);
   else /* the reference path of mpmc_mc_return_map_eig, and strains beyond the series */
     mpmc_sym3_eig(b, lam, Q);
+  return return_decomposed(ws, solver, m, lam, Q, btr, be, eps_p, tau, J_out, info, q0);
+}
+
+/* return_eig from the decomposition lam, Q of its b (of eps when btr is given) */
+static int return_decomposed(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
+                             double lam[3], double Q[3][3], const double *btr, double *be,
+                             double *eps_p, double *tau, double *J_out, mpmc_mc_info *info,
+                             const mc_mat *q0) {
+  const int lg = btr != NULL;
+  double etr[3], e[3], t[3];
   for (int a = 0; a < 3; ++a) {
     if (lg) {
       etr[a] = lam[a];
@@ -1188,14 +1203,23 @@ void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre) {
  * values), so that it is elastic in the eigen path too.  Returns 1 with be = b, tau, J
  * written; 0 leaves the point to the eigen path (plastic, near a surface, or |eps| >~ 0.18),
  * with eps in *eps_out (and 1 in *lg) when the series gave it. */
+static int elastic_check(const mpmc_mc_pre *pre, const double *b, const double *eps,
+                         double eps_p, double *be, double *tau, double *J_out, mc_mat *qout);
+
 static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, double *eps_out,
                         int *lg, double *be, double *tau, double *J_out, mc_mat *qout) {
+  *lg = 0;
+  if (mpmc_sym3_log_series(b, eps_out)) return 0;
+  *lg = 1;
+  return elastic_check(pre, b, eps_out, eps_p, be, tau, J_out, qout);
+}
+
+/* elastic_fast's check from the series strain eps of b (mpmc_mc_update4's lanes too) */
+static int elastic_check(const mpmc_mc_pre *pre, const double *b, const double *eps,
+                         double eps_p, double *be, double *tau, double *J_out, mc_mat *qout) {
   const mpmc_mc_param *m = &pre->m;
   double e[6];
-  *lg = 0;
-  if (mpmc_sym3_log_series(b, e)) return 0;
-  for (int k = 0; k < 6; ++k) eps_out[k] = e[k];
-  *lg = 1;
+  for (int k = 0; k < 6; ++k) e[k] = eps[k];
   const double tr = e[0] + e[1] + e[2], G2 = 2.0 * m->G, p = m->K * tr;
   for (int k = 0; k < 3; ++k) e[k] -= tr / 3.0;
   double s[6];
@@ -1330,6 +1354,78 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
     return MPMC_SUCCESS;
   return return_eig(ws, solver, &pre->m, lg ? eps : b, lg ? b : NULL, be, eps_p, tau, J_out,
                     info, lg ? &q0 : NULL);
+}
+
+/**
+ * @brief mpmc_mc_update of four points at once (return_mc.h): lane l of the block is point
+ * F[l], be[l], eps_p[l], tau[l], J_out[l], info[l], err[l] (its return value), l < n <= 4.
+ * The push-forward, the series Hencky strain and the closed-form eigen-decomposition of the
+ * points that need it run as batch4.h vectors, so the four points' latency chains (square
+ * roots, divisions) overlap; the elastic check, the principal return and the recomposition
+ * per point.  Every lane takes mpmc_mc_update's operations (the series at its own degree,
+ * the decomposition's branches as masks), so each point gets its results to the bit but for
+ * the sign of a zero (t414).
+ */
+void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
+                     double F[][3][3], double be[][6], double *eps_p, double tau[][6],
+                     double *J_out, mpmc_mc_info *info, int *err) {
+  v4 Fv[9], bv[6], bt[6], eps[6];
+  l4 sm = {0, 0, 0, 0}, sfail, eigm = {0, 0, 0, 0};
+  for (int l = 0; l < 4; ++l) {
+    if (l < n) {
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Fv[3 * i + j][l] = F[l][i][j];
+      for (int k = 0; k < 6; ++k) bv[k][l] = be[l][k];
+      /* elastic_fast's lanes: those mpmc_mc_update hands to it */
+      sm[l] = -(long long)(pre->valid && eps_p[l] >= 0.0 && isfinite(eps_p[l]));
+    } else { /* the identity: a finite dummy */
+      for (int k = 0; k < 9; ++k) Fv[k][l] = (k % 4 == 0);
+      for (int k = 0; k < 6; ++k) bv[k][l] = k < 3;
+    }
+  }
+  push_forward4(Fv, bv, bt);
+  sym_log_series4_lanes(bt, &sm, eps, &sfail);
+  mc_mat q0[4];
+  for (int l = 0; l < n; ++l) {
+    double b[6], e[6];
+    mpmc_mc_info *inf = info ? &info[l] : NULL;
+    for (int k = 0; k < 6; ++k) b[k] = bt[k][l];
+    if (!sm[l] || sfail[l]) { /* beyond the series, or not for elastic_fast: the eigen path */
+      err[l] = return_eig(ws, solver, &pre->m, b, NULL, be[l], &eps_p[l], tau[l], &J_out[l],
+                          inf, NULL);
+      continue;
+    }
+    for (int k = 0; k < 6; ++k) e[k] = eps[k][l];
+    err[l] = MPMC_SUCCESS;
+    if (elastic_check(pre, b, e, eps_p[l], be[l], tau[l], &J_out[l], &q0[l])) {
+      if (inf) memset(inf, 0, sizeof *inf);
+      continue;
+    }
+    if (pre->m.surface != MPMC_MC_MOHR_COULOMB &&
+        !dp_radial(ws, solver, pre, b, e, &q0[l], be[l], &eps_p[l], tau[l], &J_out[l], inf))
+      continue;
+    eigm[l] = -1;
+  }
+  if (!mask_bits(&eigm)) return;
+  v4 lam[3], Q[9];
+  l4 fb;
+  sym3_eig_closed4(eps, &eigm, lam, Q, &fb);
+  for (int bits = mask_bits(&eigm), l = 0; bits; bits >>= 1, ++l) {
+    if (!(bits & 1)) continue;
+    double b[6], lm[3], Ql[3][3];
+    for (int k = 0; k < 6; ++k) b[k] = bt[k][l];
+    if (fb[l]) { /* a special case of the closed form: its scalar code */
+      double e[6];
+      for (int k = 0; k < 6; ++k) e[k] = eps[k][l];
+      mpmc_sym3_eig_closed(e, lm, Ql);
+    } else
+      for (int a = 0; a < 3; ++a) {
+        lm[a] = lam[a][l];
+        for (int i = 0; i < 3; ++i) Ql[i][a] = Q[3 * i + a][l];
+      }
+    err[l] = return_decomposed(ws, solver, &pre->m, lm, Ql, b, be[l], &eps_p[l], tau[l],
+                               &J_out[l], info ? &info[l] : NULL, &q0[l]);
+  }
 }
 
 /**

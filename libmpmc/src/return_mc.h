@@ -146,6 +146,15 @@ void mpmc_mc_prepare(const mpmc_mc_param *m, mpmc_mc_pre *pre);
 int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[3][3],
                    double *be, double *eps_p, double *tau, double *J_out, mpmc_mc_info *info);
 
+/* mpmc_mc_update of n <= 4 points at once, lane l the point F[l], be[l], eps_p[l], tau[l],
+ * J_out[l], info[l] (info may be NULL), its return value in err[l]: the trial state, the
+ * series Hencky strain and the closed-form eigen-decomposition of four points as vectors
+ * (batch4.h), each point's results those of mpmc_mc_update (the frictional models' update
+ * over blocks of four points, material_frictional.c). */
+void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
+                     double F[][3][3], double be[][6], double *eps_p, double tau[][6],
+                     double *J_out, mpmc_mc_info *info, int *err);
+
 void mpmc_mc_reduce(mpmc_mc_param *m, double factor);
 
 #endif

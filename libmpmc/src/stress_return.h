@@ -1,6 +1,7 @@
 /* The stress update of the materials whose return map takes one point at a time: the
  * frictional models (material_frictional.c, return_mc.c) and the user yield surfaces
- * (material_user_yield.c, return_cpp.c).  stress_return.c runs their loop over the points;
+ * (material_user_yield.c, return_cpp.c).  stress_return.c runs their loop over the points
+ * (the frictional ones also in blocks of four, mpmc_return_update_blocks);
  * each model gives its return map, what else it keeps of an accepted return, and its error
  * message.  Hencky-J2 has its own loop, four points at a time (stress_j2.c). */
 #ifndef MPMC_STRESS_RETURN_H
@@ -49,6 +50,19 @@ typedef struct {
  * J is not positive keeps its state; then mpmc_return_finish. */
 int mpmc_return_update(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                        const mpmc_return_ops *ops, const void *model);
+
+/* The return map of four points at once (lane l: F[l], be[l], eps_p[l], tau[l], out[l], its
+ * return value in err[l]), each with the results ops->point would give it. */
+typedef void (*mpmc_return_block_fn)(const void *model, mpmc_rm_ws *ws, int solver,
+                                     double F[4][3][3], double be[4][6], double eps_p[4],
+                                     double tau[4][6], mpmc_return_out out[4], int err[4]);
+
+/* mpmc_return_update with the blocks of four points of material id (points 4k .. 4k + 3)
+ * handed to block (the frictional models, mpmc_mc_update4), the others to ops->point; the
+ * same results as mpmc_return_update (block NULL). */
+int mpmc_return_update_blocks(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
+                              const mpmc_return_ops *ops, mpmc_return_block_fn block,
+                              const void *model);
 
 /* The end of every return-mapping update (a loop of its own too, e.g. Hencky-J2's batches):
  * the plastic corrections nret and KINSOL fallbacks nfb counted into sim->stats; when a
