@@ -17,6 +17,7 @@
 
 typedef struct {
   double eta;             /* FLIP/PIC blend                                             */
+  double travel_scale;    /* dt / h, once a step: the anchored form's travel per |v^n|_1  */
   double *xold;           /* with F-bar's stable form xn, which gets x^n for the gather  */
   double xmin[3], xmax[3];/* points may drift up to one cell beyond the box (walls act on
                              the nodes there); further out the support leaves the grid   */
@@ -168,7 +169,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       for (int a = 0; a < DIM; ++a) vn[a] = v[a];
       double s = fabs(vn[0]) + fabs(vn[1]);
       if (DIM == 3) s += fabs(vn[2]);
-      travel = s * (dt * g->inv_h);
+      travel = s * c->travel_scale; /* dt h^-1 taken once a step: the same product */
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
       /* the product as it was when read ahead of the gather, in a block of its own: not fused
        * into the share's sum (mpmc_anchor) by the contracting kernel sets, same bits */
@@ -335,7 +336,8 @@ static int report(mpmc_sim sim, int q) {
 /** Phase 3 of the step. */
 int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   const mpmc_grid *g = &sim->grid;
-  g2p_ctx c = {.eta = sim->flip, .xold = sim->fbar == MPMC_FBAR_STABLE ? sim->p.xn : NULL};
+  g2p_ctx c = {.eta = sim->flip, .travel_scale = dt * g->inv_h,
+               .xold = sim->fbar == MPMC_FBAR_STABLE ? sim->p.xn : NULL};
   for (int a = 0; a < sim->dim; ++a) {
     c.xmin[a] = g->lo[a] - g->h;
     c.xmax[a] = g->hi[a] + g->h;
