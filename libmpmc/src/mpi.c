@@ -7,9 +7,13 @@
  * owns the points whose cell along that axis lies in its slab.  A point in cell c reaches
  * nodes c - 1 .. c + 2 along each axis (the cubic B-spline's stencil, the widest; transfer.h),
  * so rank r's points touch node planes cut[r] - 1 .. cut[r + 1] + 1 and its neighbours'
- * touch planes from cut[r + 1] - 1 on: the planes b - 2 .. b + 2 around each cut b (one more
- * each way than the stencils need) form the boundary's halo, which only the two ranks
- * either side of it reach when every slab is at least MPMC_DD_MIN_CELLS wide.
+ * touch planes from cut[r + 1] - 1 on: the planes b - 1 .. b + 1 around each cut b, which
+ * both sides' stencils reach, form the boundary's halo, which only the two ranks either side
+ * of it reach when every slab is at least MPMC_DD_MIN_CELLS wide.  A point's cell is the
+ * kernels' own, floor((x - origin) inv_h) (slab_cell; transfer.h), and migration after every
+ * step keeps each point in its rank's slab, so no stencil reaches beyond these planes (the
+ * stable F-bar form's coarser hats included: the 2h grid's and the cell centres' nodes of a
+ * point in cell c lie within c - 1 .. c + 2 too).
  *
  * Halo sums.  After P2G (mass, momentum, force, and F-bar's nodal volume in the records'
  * MPMC_VSLOT) and after G2P's F-bar scatter (fbj, or fb in the stable form) each rank sends
@@ -375,8 +379,8 @@ static int halo_box(const struct mpmc_sim_s *sim, int r, int *lo, int *hi) {
     lo[a] = g->act_lo[a];
     hi[a] = g->act_hi[a];
     if (a == ax) {
-      lo[a] = b - 2 > lo[a] ? b - 2 : lo[a];
-      hi[a] = b + 3 < hi[a] ? b + 3 : hi[a];
+      lo[a] = b - 1 > lo[a] ? b - 1 : lo[a];
+      hi[a] = b + 2 < hi[a] ? b + 2 : hi[a];
     }
     empty |= hi[a] <= lo[a];
   }
@@ -434,12 +438,12 @@ static int check_mirrors(struct mpmc_sim_s *sim) {
     if (m->axis != dd->axis) continue;
     for (int r = 1; r < dd->size; ++r) {
       const int b = dd->cut[r];
-      MPMC_CHECK(m->plane + MPMC_GHOST < b - 2 || m->plane - MPMC_GHOST > b + 2, sim->ctx,
+      MPMC_CHECK(m->plane + MPMC_GHOST < b - 1 || m->plane - MPMC_GHOST > b + 1, sim->ctx,
                  MPMC_ERR_UNSUPPORTED,
                  "a wall on node plane %d of axis %d lies within %d cells of the cut between "
                  "ranks %d and %d (cell %d): walls so close to a slab boundary are not supported "
                  "over MPI yet; use another number of ranks",
-                 m->plane, m->axis, MPMC_GHOST + 2, r - 1, r, b);
+                 m->plane, m->axis, MPMC_GHOST + 1, r - 1, r, b);
     }
   }
   return MPMC_SUCCESS;
@@ -869,10 +873,10 @@ int mpmc_sim_get_mpi_imbalance(const mpmc_sim sim, double *value, long *balances
 }
 
 /* Cut c moved out of the reach of the walls mirrored along the slab axis (check_mirrors:
- * planes within MPMC_GHOST + 2 of a cut), to the nearer allowed side within [lo, hi];
+ * planes within MPMC_GHOST + 1 of a cut), to the nearer allowed side within [lo, hi];
  * -1 if there is none. */
 static int clear_of_mirrors(const struct mpmc_sim_s *sim, int c, int lo, int hi) {
-  const int reach = MPMC_GHOST + 2;
+  const int reach = MPMC_GHOST + 1;
   for (int pass = 0; pass <= sim->nmirror; ++pass) {
     int moved = 0;
     for (int w = 0; w < sim->nmirror; ++w) {
