@@ -141,6 +141,12 @@ static inline void norm2_4(const v4 *s, v4 *r) {
   *r = s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
 }
 
+/* The series' start for a block: Z = (b - I)(b + I)^-1 (MPMC_SYM3_CAYLEY) and |Z|^2. */
+static inline void cayley4(const v4 *b, v4 *z, v4 *r2) {
+  MPMC_SYM3_CAYLEY(v4, sym_mul4, b, z);
+  norm2_4(z, r2);
+}
+
 /* The block's Hencky strain eps = 1/2 ln b (the trial b of Hencky-J2, the b of Hencky) by
  * linalg.h's series, mpmc_sym3_log_series' operations lane by lane (its macros
  * MPMC_SYM3_CAYLEY and MPMC_SYM3_ATANH_HORNER), at the degree the largest active lane (mask
@@ -148,10 +154,8 @@ static inline void norm2_4(const v4 *s, v4 *r) {
  * strain the series cannot take (|Z|^2 above the table, or not finite). */
 static inline void sym_log_series4(const v4 *b, const l4 *am, v4 *eps, l4 *fail) {
   const double *rho2_max = mpmc_atanh_rho2_max;
-  v4 z[6];
-  MPMC_SYM3_CAYLEY(v4, sym_mul4, b, z);
-  v4 r2;
-  norm2_4(z, &r2);
+  v4 z[6], r2;
+  cayley4(b, z, &r2);
   /* fail: |Z|^2 beyond the table or not finite; the degree: that of the largest other lane */
   const l4 ok = *am & (r2 <= rho2_max[10]);
   *fail = *am & ~ok;
@@ -192,10 +196,8 @@ static inline int bits4_of(const int c0, const int c1, const int c2, const int c
  * (their eps is not formed). */
 static inline void sym_log_series4_lanes(const v4 *b, const l4 *am, v4 *eps, l4 *fail) {
   const double *rho2_max = mpmc_atanh_rho2_max;
-  v4 z[6];
-  MPMC_SYM3_CAYLEY(v4, sym_mul4, b, z);
-  v4 r2;
-  norm2_4(z, &r2);
+  v4 z[6], r2;
+  cayley4(b, z, &r2);
   int deg[4], n = 1, fbits = 0;
   const int abits = mask_bits(am);
   for (int l = 0; l < 4; ++l) { /* each lane's number of terms, as mpmc_sym3_log_series' */
@@ -268,13 +270,7 @@ static inline void sym3_eig_closed4(const v4 *s, const l4 *am, v4 *lam, v4 *Q, l
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) C[i][j] = i == j ? Bn[i][j] - li : Bn[i][j];
   v4 x[3][3], n2[3];
-  for (int k = 0; k < 3; ++k) { /* the cross products of rows (0,1), (0,2), (1,2) */
-    const v4 *a = C[k == 2 ? 1 : 0], *b = C[k == 0 ? 1 : 2];
-    x[k][0] = a[1] * b[2] - a[2] * b[1];
-    x[k][1] = a[2] * b[0] - a[0] * b[2];
-    x[k][2] = a[0] * b[1] - a[1] * b[0];
-    n2[k] = x[k][0] * x[k][0] + x[k][1] * x[k][1] + x[k][2] * x[k][2];
-  }
+  MPMC_SYM3_ROW_CROSSES(v4, C, x, n2);
   const l4 c01 = CMP4(n2[0], >=, n2[1]), c02 = CMP4(n2[0], >=, n2[2]),
            c12 = CMP4(n2[1], >=, n2[2]);
   const l4 k0 = c01 & c02, k1 = ~c01 & c12; /* else row pair 2 */
@@ -299,17 +295,8 @@ static inline void sym3_eig_closed4(const v4 *s, const l4 *am, v4 *lam, v4 *Q, l
                    SEL4(cu, v[0] * iu, -v[1] * iu)};
   const v4 w[3] = {v[1] * u[2] - v[2] * u[1], v[2] * u[0] - v[0] * u[2],
                    v[0] * u[1] - v[1] * u[0]};
-  v4 Bv[3], Bu[3], Bw[3];
-  for (int i = 0; i < 3; ++i) {
-    Bv[i] = B[i][0] * v[0] + B[i][1] * v[1] + B[i][2] * v[2];
-    Bu[i] = B[i][0] * u[0] + B[i][1] * u[1] + B[i][2] * u[2];
-    Bw[i] = B[i][0] * w[0] + B[i][1] * w[1] + B[i][2] * w[2];
-  }
-  const v4 lv = v[0] * Bv[0] + v[1] * Bv[1] + v[2] * Bv[2];
-  const v4 a00 = u[0] * Bu[0] + u[1] * Bu[1] + u[2] * Bu[2];
-  const v4 a11 = w[0] * Bw[0] + w[1] * Bw[1] + w[2] * Bw[2];
-  const v4 a01 = 0.5 * (u[0] * Bw[0] + u[1] * Bw[1] + u[2] * Bw[2] + w[0] * Bu[0] +
-                        w[1] * Bu[1] + w[2] * Bu[2]);
+  v4 lv, a00, a11, a01;
+  MPMC_SYM3_IN_BASIS(v4, B, v, u, w, lv, a00, a11, a01);
   /* the rotation of mpmc_sym3_eig where a01 != 0, else c = 1, sn = t = 0 */
   const l4 nz = ok & CMP4(a01, !=, zero);
   const v4 a01s = SEL4(nz, a01, one);

@@ -98,6 +98,36 @@ static inline void mpmc_sym3_eig(const double *s, double lam[3], double Q[3][3])
   for (int a = 0; a < 3; ++a) lam[a] = A[a][a];
 }
 
+/* The cross products x[k] of the rows (0,1), (0,2), (1,2) of C (3x3) and their squared
+ * norms n2[k], shared by mpmc_sym3_eig_closed and batch4.h's four lanes (T double or v4). */
+#define MPMC_SYM3_ROW_CROSSES(T, C, x, n2)                                                \
+  do {                                                                                    \
+    for (int k_ = 0; k_ < 3; ++k_) {                                                      \
+      const T *a_ = (C)[k_ == 2 ? 1 : 0], *b_ = (C)[k_ == 0 ? 1 : 2];                     \
+      (x)[k_][0] = a_[1] * b_[2] - a_[2] * b_[1];                                         \
+      (x)[k_][1] = a_[2] * b_[0] - a_[0] * b_[2];                                         \
+      (x)[k_][2] = a_[0] * b_[1] - a_[1] * b_[0];                                         \
+      (n2)[k_] = (x)[k_][0] * (x)[k_][0] + (x)[k_][1] * (x)[k_][1] + (x)[k_][2] * (x)[k_][2]; \
+    }                                                                                     \
+  } while (0)
+/* B (3x3, symmetric) in the orthonormal basis v, u, w, shared by mpmc_sym3_eig_closed and
+ * batch4.h's four lanes (T double or v4): lv = v.Bv, and the 2x2 block a00 = u.Bu,
+ * a11 = w.Bw, a01 = (u.Bw + w.Bu) / 2 on the complement of v (declared by the caller). */
+#define MPMC_SYM3_IN_BASIS(T, B, v, u, w, lv, a00, a11, a01)                               \
+  do {                                                                                     \
+    T Bv_[3], Bu_[3], Bw_[3];                                                              \
+    for (int i_ = 0; i_ < 3; ++i_) {                                                       \
+      Bv_[i_] = (B)[i_][0] * (v)[0] + (B)[i_][1] * (v)[1] + (B)[i_][2] * (v)[2];           \
+      Bu_[i_] = (B)[i_][0] * (u)[0] + (B)[i_][1] * (u)[1] + (B)[i_][2] * (u)[2];           \
+      Bw_[i_] = (B)[i_][0] * (w)[0] + (B)[i_][1] * (w)[1] + (B)[i_][2] * (w)[2];           \
+    }                                                                                      \
+    (lv) = (v)[0] * Bv_[0] + (v)[1] * Bv_[1] + (v)[2] * Bv_[2];                            \
+    (a00) = (u)[0] * Bu_[0] + (u)[1] * Bu_[1] + (u)[2] * Bu_[2];                           \
+    (a11) = (w)[0] * Bw_[0] + (w)[1] * Bw_[1] + (w)[2] * Bw_[2];                           \
+    (a01) = 0.5 * ((u)[0] * Bw_[0] + (u)[1] * Bw_[1] + (u)[2] * Bw_[2] + (w)[0] * Bu_[0] + \
+                   (w)[1] * Bu_[1] + (w)[2] * Bu_[2]);                                     \
+  } while (0)
+
 /* The same decomposition in closed form, ~10x cheaper than the Jacobi sweeps (the eigen path
  * of a plastic frictional point, return_mc.c).  With m = tr(s)/3, B = s - m I, p^2 = B:B/6:
  *   the eigenvalues of B are 2p cos(phi - 2 pi k/3), phi = acos(det(B/p)/2)/3 in [0, pi/3];
@@ -141,13 +171,7 @@ static inline void mpmc_sym3_eig_closed(const double *s, double lam[3], double Q
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) C[i][j] = Bn[i][j] - (i == j ? li : 0.0);
   double x[3][3], n2[3];
-  for (int k = 0; k < 3; ++k) { /* the cross products of rows (0,1), (0,2), (1,2) */
-    const double *a = C[k == 2 ? 1 : 0], *b = C[k == 0 ? 1 : 2];
-    x[k][0] = a[1] * b[2] - a[2] * b[1];
-    x[k][1] = a[2] * b[0] - a[0] * b[2];
-    x[k][2] = a[0] * b[1] - a[1] * b[0];
-    n2[k] = x[k][0] * x[k][0] + x[k][1] * x[k][1] + x[k][2] * x[k][2];
-  }
+  MPMC_SYM3_ROW_CROSSES(double, C, x, n2);
   const int kb = n2[0] >= n2[1] ? (n2[0] >= n2[2] ? 0 : 2) : (n2[1] >= n2[2] ? 1 : 2);
   if (!(n2[kb] > 0.0)) { /* not reached for a finite s (the cross products are >= ~1) */
     mpmc_sym3_eig(s, lam, Q);
@@ -166,17 +190,8 @@ static inline void mpmc_sym3_eig_closed(const double *s, double lam[3], double Q
   }
   const double w[3] = {v[1] * u[2] - v[2] * u[1], v[2] * u[0] - v[0] * u[2],
                        v[0] * u[1] - v[1] * u[0]};
-  double Bv[3], Bu[3], Bw[3];
-  for (int i = 0; i < 3; ++i) {
-    Bv[i] = B[i][0] * v[0] + B[i][1] * v[1] + B[i][2] * v[2];
-    Bu[i] = B[i][0] * u[0] + B[i][1] * u[1] + B[i][2] * u[2];
-    Bw[i] = B[i][0] * w[0] + B[i][1] * w[1] + B[i][2] * w[2];
-  }
-  const double lv = v[0] * Bv[0] + v[1] * Bv[1] + v[2] * Bv[2];
-  const double a00 = u[0] * Bu[0] + u[1] * Bu[1] + u[2] * Bu[2];
-  const double a11 = w[0] * Bw[0] + w[1] * Bw[1] + w[2] * Bw[2];
-  const double a01 = 0.5 * (u[0] * Bw[0] + u[1] * Bw[1] + u[2] * Bw[2] + w[0] * Bu[0] +
-                            w[1] * Bu[1] + w[2] * Bu[2]);
+  double lv, a00, a11, a01;
+  MPMC_SYM3_IN_BASIS(double, B, v, u, w, lv, a00, a11, a01);
   double c = 1.0, sn = 0.0, t = 0.0; /* the rotation of mpmc_sym3_eig */
   if (a01 != 0.0) {
     const double theta = (a11 - a00) / (2.0 * a01);
