@@ -187,7 +187,8 @@ static int order_update(mpmc_sim sim, int *width_io) {
   int top = -1; /* ids are unique; order them by a table over [0, largest id] */
   for (long k = 0; k < all; ++k) top = gid[k] > top ? gid[k] : top;
   long *at = malloc(sizeof(long) * (size_t)(top + 2));
-  if (at) {
+  const int made = at != NULL;
+  if (made) {
     for (long k = 0; k <= top; ++k) at[k] = -1;
     for (long k = 0; k < all; ++k) at[gid[k]] = k;
     long j = 0;
@@ -196,7 +197,7 @@ static int order_update(mpmc_sim sim, int *width_io) {
   }
   free(gid);
   free(at);
-  if (wf_par_agree(at ? 0 : MPMC_ERR_MEMORY)) return MPMC_ERR_MEMORY;
+  if (wf_par_agree(made ? 0 : MPMC_ERR_MEMORY)) return MPMC_ERR_MEMORY;
   order.sim = sim;
   order.steps = st.steps;
   order.n = n;
