@@ -65,6 +65,13 @@ static inline int test_lattice2(const double *lo, const double *hi, double h, in
   return n;
 }
 
+/* The 2D box's walls of the tests: slip sides (faces x lo and x hi), fixed base (y lo). */
+static inline void test_walls2(mpmc_context ctx, mpmc_sim sim) {
+  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
+  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
+  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+}
+
 /* A Hencky block (E 1e5 Pa, nu 0.3, 1000 kg/m^3), 2 x 2 points a cell, x in [0, 1] and y in
  * [ylo, yhi] of a 1 x 30 m grid of 0.5 m cells (B-spline2, anchored F-bar, gravity, slip
  * sides, fixed base), moving at vy (1 + stretch (y - its middle)): the top faster than the
@@ -88,9 +95,7 @@ static inline mpmc_sim test_block(mpmc_context ctx, MPI_Comm comm, double ylo, d
   MCALL(ctx, mpmc_sim_add_particles(sim, *n, x, vol, mat, NULL));
   free(x);
   free(vol);
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  test_walls2(ctx, sim);
   int nl;
   double *v;
   MCALL(ctx, mpmc_sim_get_num_particles(sim, &nl));

@@ -47,9 +47,7 @@ static void column(MPI_Comm comm, int basis, int fbar, double Hg, double k0, dou
         x[2 * (n - 1 - i) + a] = t;
       }
   MCALL(ctx, mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  test_walls2(ctx, sim);
   if (k0 > 0) MCALL(ctx, mpmc_sim_set_geostatic_stress(sim, k0));
   for (int s = 0; s < STEPS; ++s) MCALL(ctx, mpmc_sim_step(sim, dt));
   *ntotal = n;

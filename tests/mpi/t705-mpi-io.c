@@ -50,9 +50,7 @@ static mpmc_sim column(mpmc_context ctx, MPI_Comm comm, int *ntotal) {
   const double plo[2] = {0, 0}, phi[2] = {W, H};
   *ntotal = test_lattice2(plo, phi, h, 2, &x, &vol);
   MCALL(ctx, mpmc_sim_add_particles(sim, *ntotal, x, vol, mat, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  test_walls2(ctx, sim);
   int n, m = 0;
   double *xs;
   MCALL(ctx, mpmc_sim_get_num_particles(sim, &n));

@@ -86,9 +86,7 @@ static void run(const rcase *c, MPI_Comm comm, double xc, int perturb, double *o
   MCALL(ctx, mpmc_sim_add_particles(sim, n, x, vol, mat, NULL));
   free(x);
   free(vol);
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 0, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 1, MPMC_WALL_SLIP, NULL));
-  MCALL(ctx, mpmc_sim_add_wall_face(sim, 2, MPMC_WALL_FIXED, NULL));
+  test_walls2(ctx, sim);
   int body;
   if (c->kind == FOOTING) {
     const double lo[2] = {xc - 0.75, D}, hi[2] = {xc + 0.25, D + 0.5};
