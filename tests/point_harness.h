@@ -32,7 +32,7 @@ static inline void point_seed(point *P) {
 /* dF: dim x dim row-major */
 static inline void point_apply(point *P, const double *dF) {
   struct mpmc_sim_s *s = P->sim;
-  const int d = s->dim;
+  const int d = s->cfg.dim;
   for (int k = 0; k < d * d; ++k) s->p.dF[k] = dF[k];
   double F3[3][3];
   mpmc_embed(d, dF, F3);

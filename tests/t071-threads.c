@@ -56,7 +56,7 @@ static void run(int dim, int nthreads, int fbar, int basis, int compact, snap *o
   const int expect = compact && nthreads == 2 ? 2 : 0;
   if (sim->grid.nprivate != expect)
     fail_msg("P2G on %d threads: per-thread grids %d, expected %d (%d slabs)", nthreads,
-             sim->grid.nprivate, expect, sim->nslab);
+             sim->grid.nprivate, expect, sim->scr.nslab);
   double *f;
   out->n = n;
   const int fields[4] = {MPMC_FIELD_POSITION, MPMC_FIELD_VELOCITY, MPMC_FIELD_STRESS, MPMC_FIELD_J};
@@ -157,20 +157,20 @@ static void test_slab_order(void **state) {
   }
   TCALL(mpmc_sim_prepare(sim));
   TCALL(mpmc_slabs_build(sim)); /* slabs for OMP_NUM_THREADS = 2 (CTest's environment) */
-  const int ax = sim->slab_axis, ns = sim->nslab;
+  const int ax = sim->scr.slab_axis, ns = sim->scr.nslab;
   if (ns < 4) fail_msg("%d slabs: expected at least 4 for two threads (OMP_NUM_THREADS=2)", ns);
   const mpmc_grid *g = &sim->grid;
   unsigned char *seen = calloc((size_t)n, 1);
   int last_plane = -1;
   for (int sl = 0; sl < ns; ++sl) {
     int pmin = INT_MAX, pmax = -1;
-    for (int k = sim->slab_start[sl]; k < sim->slab_start[sl + 1]; ++k) {
-      const int q = sim->order[k];
+    for (int k = sim->scr.slab_start[sl]; k < sim->scr.slab_start[sl + 1]; ++k) {
+      const int q = sim->scr.order[k];
       if (q < 0 || q >= n || seen[q]) fail_msg("order[%d] = %d: not a permutation", k, q);
       seen[q] = 1;
       const int pl = (int)((x[3 * q + ax] - g->origin[ax]) * g->inv_h);
-      if (k > sim->slab_start[sl]) {
-        const int qp = sim->order[k - 1];
+      if (k > sim->scr.slab_start[sl]) {
+        const int qp = sim->scr.order[k - 1];
         const int plp = (int)((x[3 * qp + ax] - g->origin[ax]) * g->inv_h);
         if (pl < plp || (pl == plp && q < qp))
           fail_msg("slab %d: point %d (plane %d) after point %d (plane %d)", sl, q, pl, qp, plp);
@@ -181,18 +181,18 @@ static void test_slab_order(void **state) {
     if (pmin <= last_plane) fail_msg("slab %d starts at plane %d, the slab before ends at %d", sl, pmin, last_plane);
     last_plane = pmax;
   }
-  if (sim->slab_start[ns] != n) fail_msg("slabs hold %d of %d points", sim->slab_start[ns], n);
+  if (sim->scr.slab_start[ns] != n) fail_msg("slabs hold %d of %d points", sim->scr.slab_start[ns], n);
   int *first = malloc(sizeof(int) * (size_t)n);
-  memcpy(first, sim->order, sizeof(int) * (size_t)n);
-  sim->slab_axis = 2; /* a wrong start: the build must count again along x */
+  memcpy(first, sim->scr.order, sizeof(int) * (size_t)n);
+  sim->scr.slab_axis = 2; /* a wrong start: the build must count again along x */
   const int saved = omp_get_max_threads();
   omp_set_num_threads(1);
   TCALL(mpmc_slabs_build(sim));
   omp_set_num_threads(saved);
-  if (sim->slab_axis != ax) fail_msg("slab axis %d from a wrong start, %d before", sim->slab_axis, ax);
+  if (sim->scr.slab_axis != ax) fail_msg("slab axis %d from a wrong start, %d before", sim->scr.slab_axis, ax);
   for (int k = 0; k < n; ++k)
-    if (sim->order[k] != first[k])
-      fail_msg("order[%d] = %d on one thread, %d on %d", k, sim->order[k], first[k], saved);
+    if (sim->scr.order[k] != first[k])
+      fail_msg("order[%d] = %d on one thread, %d on %d", k, sim->scr.order[k], first[k], saved);
   free(first);
   free(seen);
   /* the axis rule: z once the points span MPMC_SLAB_PLANES planes along it (the landslide:
@@ -224,12 +224,12 @@ static void test_slab_groups(void **state) {
   for (int nt = 2; nt <= 3; ++nt) {
     omp_set_num_threads(nt);
     TCALL(mpmc_slabs_build(sim));
-    const int ns = sim->nslab;
-    if (sim->slab_nt != nt) fail_msg("slab runs for %d threads, expected %d", sim->slab_nt, nt);
+    const int ns = sim->scr.nslab;
+    if (sim->scr.slab_nt != nt) fail_msg("slab runs for %d threads, expected %d", sim->scr.slab_nt, nt);
     for (int c = 0; c < 2; ++c) {
       long total = 0, kmax = 0;
       for (int sl = c; sl < ns; sl += 2) {
-        const long k = sim->slab_start[sl + 1] - sim->slab_start[sl];
+        const long k = sim->scr.slab_start[sl + 1] - sim->scr.slab_start[sl];
         total += k;
         kmax = k > kmax ? k : kmax;
       }
@@ -244,8 +244,8 @@ static void test_slab_groups(void **state) {
         long pts = 0;
         for (int sl = s0; sl < s1; sl += 2) {
           long before = 0; /* the colour's points in the slabs before sl */
-          for (int o = c; o < sl; o += 2) before += sim->slab_start[o + 1] - sim->slab_start[o];
-          const long k = sim->slab_start[sl + 1] - sim->slab_start[sl];
+          for (int o = c; o < sl; o += 2) before += sim->scr.slab_start[o + 1] - sim->scr.slab_start[o];
+          const long k = sim->scr.slab_start[sl + 1] - sim->scr.slab_start[sl];
           const int owner = (int)floor((before + 0.5 * k) * nt / (double)total);
           if ((owner < nt ? owner : nt - 1) != t)
             fail_msg("%d threads, colour %d: slab %d (points %ld .. %ld of %ld) in thread %d's "
@@ -264,7 +264,7 @@ static void test_slab_groups(void **state) {
   mpmc_context_destroy(&ctx);
 }
 
-/* G2P's index-order path (sim->order_ident, g2p.c): the slab build flags an order that is
+/* G2P's index-order path (sim->scr.order_ident, g2p.c): the slab build flags an order that is
  * the identity, and only then.  Seeded x fastest, the box's points are not
  * in the order of its slab axis, x; sorted (the slab axis outermost), they are, on one thread
  * and on two; a point moved to a plane of its own breaks it.  With the flag on, G2P (F-bar's
@@ -282,17 +282,17 @@ static void test_index_order(void **state) {
   TCALL(mpmc_sim_set_gravity(sim, g));
   TCALL(mpmc_sim_prepare(sim));
   TCALL(mpmc_slabs_build(sim));
-  if (sim->slab_axis != 0 || sim->order_ident)
+  if (sim->scr.slab_axis != 0 || sim->scr.order_ident)
     fail_msg("seeded x fastest: slab axis %d, identity flag %d; expected axis 0 and no identity",
-             sim->slab_axis, sim->order_ident);
+             sim->scr.slab_axis, sim->scr.order_ident);
   TCALL(mpmc_sim_sort_particles(sim));
   const int saved = omp_get_max_threads();
   for (int nt = 1; nt <= 2; ++nt) {
     omp_set_num_threads(nt);
     TCALL(mpmc_slabs_build(sim));
-    if (!sim->order_ident) fail_msg("sorted, %d thread(s): no identity flag", nt);
+    if (!sim->scr.order_ident) fail_msg("sorted, %d thread(s): no identity flag", nt);
     for (int k = 0; k < n; ++k)
-      if (sim->order[k] != k) fail_msg("sorted, %d thread(s): order[%d] = %d", nt, k, sim->order[k]);
+      if (sim->scr.order[k] != k) fail_msg("sorted, %d thread(s): order[%d] = %d", nt, k, sim->scr.order[k]);
   }
   omp_set_num_threads(saved);
   double *v;
@@ -311,14 +311,15 @@ static void test_index_order(void **state) {
   for (int run = 0; run < 2; ++run) {
     memcpy(p->x, x0, sizeof(double) * n3), memcpy(p->v, v0, sizeof(double) * n3);
     memcpy(p->J, J0, sizeof(double) * (size_t)n), memcpy(p->Jbar, Jb0, sizeof(double) * (size_t)n);
-    mpmc_grid_clear(&sim->grid, 1);
+    mpmc_grid_clear(&sim->grid);
+    mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_ALL);
     TCALL(mpmc_slabs_build(sim));
-    if (!sim->order_ident) fail_msg("run %d: no identity flag", run);
-    if (run) sim->order_ident = 0; /* the same sequence through the order */
+    if (!sim->scr.order_ident) fail_msg("run %d: no identity flag", run);
+    if (run) sim->scr.order_ident = 0; /* the same sequence through the order */
     TCALL(mpmc_p2g(sim, 1e-4));
     TCALL(mpmc_grid_update(sim, 1e-4));
     TCALL(mpmc_g2p(sim, 1e-4));
-    const double *src[6] = {sim->grid.node, sim->grid.fbj, p->x, p->v, p->dF, p->J};
+    const double *src[6] = {sim->grid.node, sim->fb.fbj, p->x, p->v, p->dF, p->J};
     for (int f = 0; f < 6; ++f) {
       out[run][f] = malloc(sizeof(double) * len[f]);
       memcpy(out[run][f], src[f], sizeof(double) * len[f]);
@@ -339,8 +340,8 @@ static void test_index_order(void **state) {
   /* one point to a plane beyond the others' (the sorted order no longer the identity) */
   p->x[0] = 1.75;
   TCALL(mpmc_slabs_build(sim));
-  if (sim->order_ident) fail_msg("point 0 moved to x = 1.75: still flagged as identity");
-  if (sim->order[n - 1] != 0) fail_msg("point 0 moved to the last plane: order[%d] = %d", n - 1, sim->order[n - 1]);
+  if (sim->scr.order_ident) fail_msg("point 0 moved to x = 1.75: still flagged as identity");
+  if (sim->scr.order[n - 1] != 0) fail_msg("point 0 moved to the last plane: order[%d] = %d", n - 1, sim->scr.order[n - 1]);
   free(x0), free(v0), free(J0), free(Jb0);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);

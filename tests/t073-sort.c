@@ -185,7 +185,7 @@ static void compare(const result *a, const result *b, const char *what) {
 static long out_of_order(mpmc_sim sim) {
   const mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (int q = 0; q < p->n; ++q)
     for (int a = 0; a < d; ++a) {
@@ -344,7 +344,7 @@ static void expect_same_run(mpmc_sim a, mpmc_sim b) {
   const int *ia, *ib;
   TCALL(mpmc_sim_get_particle_ids(a, &ia));
   TCALL(mpmc_sim_get_particle_ids(b, &ib));
-  const size_t n = (size_t)a->p.n, d = (size_t)a->dim;
+  const size_t n = (size_t)a->p.n, d = (size_t)a->cfg.dim;
   if (b->p.n != a->p.n || memcmp(ia, ib, sizeof(int) * n)) fail_msg("ids differ after the restart");
   if (memcmp(a->p.x, b->p.x, sizeof(double) * d * n) || memcmp(a->p.v, b->p.v, sizeof(double) * d * n) ||
       memcmp(a->p.stress, b->p.stress, sizeof(double) * 6 * n))

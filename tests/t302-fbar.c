@@ -33,7 +33,8 @@ static mpmc_sim make(mpmc_context ctx, int dim, int basis, int mode, int ncell, 
   TCALL(mpmc_sim_add_particles(sim, *n, *x, vol, mat, NULL));
   free(vol);
   TCALL(mpmc_sim_prepare(sim));
-  mpmc_grid_clear(&sim->grid, 1);
+  mpmc_grid_clear(&sim->grid);
+  mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_ALL);
   TCALL(mpmc_slabs_build(sim)); /* the projection scatters by the slabs P2G builds */
   return sim;
 }
@@ -271,15 +272,17 @@ static void test_fb_cleared(void **state) {
         for (int s = 0; s < steps; ++s) {
           TCALL(mpmc_sim_step(sim, dt));
           mpmc_grid_clear_active(&sim->grid);
+          mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_BOX);
           const mpmc_grid *g = &sim->grid;
-          if ((g->fb != NULL) != (m == MPMC_FBAR_STABLE))
-            fail_msg("dim %d form %d: fb %s", dim, m, g->fb ? "allocated" : "missing");
+          const mpmc_fbar_state *f = &sim->fb;
+          if ((f->fb != NULL) != (m == MPMC_FBAR_STABLE))
+            fail_msg("dim %d form %d: fb %s", dim, m, f->fb ? "allocated" : "missing");
           for (size_t i = 0; i < g->nn; ++i) {
-            const double fb0 = g->fb ? g->fb[2 * i] : 0.0, fb1 = g->fb ? g->fb[2 * i + 1] : 0.0;
+            const double fb0 = f->fb ? f->fb[2 * i] : 0.0, fb1 = f->fb ? f->fb[2 * i + 1] : 0.0;
             const double vs = g->node[i * MPMC_NREC + MPMC_VSLOT];
-            if (fb0 != 0.0 || fb1 != 0.0 || g->fbj[i] != 0.0 || vs != 0.0)
+            if (fb0 != 0.0 || fb1 != 0.0 || f->fbj[i] != 0.0 || vs != 0.0)
               fail_msg("dim %d form %d basis %d step %d: node %zu fb (%g, %g), fbj %g, volume "
-                       "slot %g after the reset", dim, m, b, s, i, fb0, fb1, g->fbj[i], vs);
+                       "slot %g after the reset", dim, m, b, s, i, fb0, fb1, f->fbj[i], vs);
           }
         }
         mpmc_sim_destroy(&sim);
@@ -295,6 +298,7 @@ static void test_fb_cleared(void **state) {
  * the ranges held and those of the box to *ranged and *boxed. */
 static void check_rows(mpmc_sim sim, const char *what, int s, long *ranged, long *boxed) {
   const mpmc_grid *g = &sim->grid;
+  const mpmc_fbar_state *f = &sim->fb;
   for (int kz = 0; kz < g->n[2]; ++kz)
     for (int j = 0; j < g->n[1]; ++j) {
       const size_t row = (size_t)j + (size_t)g->n[1] * (size_t)kz;
@@ -310,7 +314,7 @@ static void check_rows(mpmc_sim sim, const char *what, int s, long *ranged, long
       }
       for (int i = 0; i < g->n[0]; ++i) {
         const size_t nd = (size_t)i + (size_t)g->n[0] * row;
-        int nonzero = g->fbj[nd] != 0.0 || (g->fb && (g->fb[2 * nd] != 0.0 || g->fb[2 * nd + 1] != 0.0));
+        int nonzero = f->fbj[nd] != 0.0 || (f->fb && (f->fb[2 * nd] != 0.0 || f->fb[2 * nd + 1] != 0.0));
         for (int e = 0; e < MPMC_NREC; ++e) nonzero |= g->node[nd * MPMC_NREC + e] != 0.0;
         if (nonzero && !(in_box && i >= rlo && i < rhi))
           fail_msg("%s step %d: node (%d, %d, %d) holds values outside its row's range [%d, "
@@ -318,8 +322,9 @@ static void check_rows(mpmc_sim sim, const char *what, int s, long *ranged, long
       }
     }
   mpmc_grid_clear_active(&sim->grid);
+  mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_BOX);
   for (size_t i = 0; i < g->nn; ++i) {
-    int nonzero = g->fbj[i] != 0.0 || (g->fb && (g->fb[2 * i] != 0.0 || g->fb[2 * i + 1] != 0.0));
+    int nonzero = f->fbj[i] != 0.0 || (f->fb && (f->fb[2 * i] != 0.0 || f->fb[2 * i + 1] != 0.0));
     for (int e = 0; e < MPMC_NREC; ++e) nonzero |= g->node[i * MPMC_NREC + e] != 0.0;
     if (nonzero) fail_msg("%s step %d: node %zu nonzero after the reset", what, s, i);
   }
@@ -435,7 +440,7 @@ static void test_row_ranges_mirrors(void **state) {
 }
 
 /* The step leaves the gather to the material update when every material runs it (fbar.c,
- * grid.fb_gather: Hencky-J2, Hencky, Neo-Hookean, Newtonian): the same bits as the gather as a
+ * sim->fb.deferred: Hencky-J2, Hencky, Neo-Hookean, Newtonian): the same bits as the gather as a
  * phase of its own, which an unused user material beside it brings back.  A 3D and a 2D
  * block slumping under gravity, 40 steps, every basis and form: softening J2 soil (plastic
  * points, the return maps' chunks), and each of the other three models; the deferred path
@@ -537,12 +542,12 @@ static void test_deferred_gather(void **state) {
  * total forms), axis by axis as the 1D weights. */
 static double projected_at(const mpmc_sim sim, const double *xs, int q) {
   const mpmc_grid *g = &sim->grid;
-  const int d = sim->dim, basis = sim->basis, S = mpmc_stencil(basis);
-  if (sim->fbar == MPMC_FBAR_STABLE) {
+  const int d = sim->cfg.dim, basis = sim->cfg.basis, S = mpmc_stencil(basis);
+  if (sim->cfg.fbar == MPMC_FBAR_STABLE) {
     mpmc_spw sp;
     mpmc_stable_weights(d, basis, g, xs + (size_t)q * d, &sp);
     double pi = 0.0;
-    MPMC_STABLE_LOOP(d, basis, sp, { pi += w * g->fbj[node]; });
+    MPMC_STABLE_LOOP(d, basis, sp, { pi += w * sim->fb.fbj[node]; });
     return pi;
   }
   double w[3][MPMC_MAX_STENCIL] = {{0}}, dw[MPMC_MAX_STENCIL];
@@ -558,7 +563,7 @@ static double projected_at(const mpmc_sim sim, const double *xs, int q) {
     for (int j = 0; j < S; ++j)
       for (int i = 0; i < S; ++i)
         pi += w[0][i] * w[1][j] * (d == 3 ? w[2][k] : 1.0) *
-              g->fbj[node0 + (size_t)i + sy * (size_t)j + sz * (size_t)k];
+              sim->fb.fbj[node0 + (size_t)i + sy * (size_t)j + sz * (size_t)k];
   return pi;
 }
 
@@ -625,11 +630,11 @@ static void test_kept_fields(void **state) {
     TCALL(mpmc_sim_stable_dt(sim, 0.3, &dt));
     TCALL(mpmc_sim_step(sim, dt));
     const int kept = form != MPMC_FBAR_OFF && form != MPMC_FBAR_STABLE;
-    if ((sim->p.xn != NULL) != (form == MPMC_FBAR_STABLE) || (sim->p.xoff != NULL) != kept ||
-        (sim->p.xnode != NULL) != kept || (sim->p.Janc != NULL) != (form == MPMC_FBAR_ANCHORED))
+    if ((sim->fb.xn != NULL) != (form == MPMC_FBAR_STABLE) || (sim->fb.xoff != NULL) != kept ||
+        (sim->fb.xnode != NULL) != kept || (sim->p.Janc != NULL) != (form == MPMC_FBAR_ANCHORED))
       fail_msg("form %d: x^n %s, offsets %s, first nodes %s, anchored J %s", form,
-               sim->p.xn ? "kept" : "absent", sim->p.xoff ? "kept" : "absent",
-               sim->p.xnode ? "kept" : "absent", sim->p.Janc ? "kept" : "absent");
+               sim->fb.xn ? "kept" : "absent", sim->fb.xoff ? "kept" : "absent",
+               sim->fb.xnode ? "kept" : "absent", sim->p.Janc ? "kept" : "absent");
     double worst = 0.0;
     for (int q = 0; q < n && form != MPMC_FBAR_OFF; ++q) {
       const double e = fabs(projected_at(sim, xn, q) - sim->p.Jbar[q]);

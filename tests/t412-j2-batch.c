@@ -56,7 +56,7 @@ static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
 /* random inputs: b_e^n SPD (some far from I), eps_p, dF of strain magnitudes 1e-9 .. 0.3 */
 static void fill(mpmc_sim sim) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   for (int q = 0; q < NP; ++q) {
     /* a few beyond the series (|eps| > 0.18), half of the rest inside the yield surface */
     const double big = q % 11 == 5 ? 0.4 : q % 2 ? 0.001 : 0.02;

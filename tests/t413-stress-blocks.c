@@ -58,7 +58,7 @@ static mpmc_sim make(mpmc_context ctx, int dim, int *mats) {
  * dF of strain magnitudes 1e-9 .. 0.05, J within 1 % of 1 */
 static void fill(mpmc_sim sim) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   for (int q = 0; q < NP; ++q) {
     const int large = q % 5 == 2 && !(q >= 56 && q < 64); /* Hencky blocks 56, 60: series */
     rand_spd(d, large ? 0.4 : q % 2 ? 1e-6 : 0.02, p->be + q * 6);
@@ -130,12 +130,12 @@ static void run_dim(int dim) {
     memcpy(p->be, be0, sizeof be0);
     memcpy(p->dF, dF0, sizeof(double) * NP * dim * dim);
     for (int k = 0; k < 6 * NP; ++k) p->stress[k] = 0.0;
-    sim->stress_bad = INT_MAX;
+    sim->scr.stress_bad = INT_MAX;
     for (int k = 0; k < 4; ++k) {
       const int m = mats[k];
       TCALL(sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, DT));
     }
-    assert_int_equal(sim->stress_bad, INT_MAX);
+    assert_int_equal(sim->scr.stress_bad, INT_MAX);
     memcpy(got_be[s], p->be, sizeof be0);
     memcpy(got_s[s], p->stress, sizeof(double) * 6 * NP);
     const int exact = s < 2; /* no contraction in baseline and AVX2 (but ln J: the series) */

@@ -89,14 +89,14 @@ static inline void det_sym4(const v4 *b, v4 *r) { *r = MPMC_DET_SYM(b); }
  * stress_blocks.c), also the chunks of F-bar's deferred gather */
 #define MPMC_BLOCK_CHUNK 64
 
-/* F-bar's deferred gather (fbar.c, grid.fb_gather) of chunk ch's points of material id, of
- * nblk blocks over n points: their factors into sim->fb_scale, which the update reads as it
+/* F-bar's deferred gather (fbar.c, sim->fb.deferred) of chunk ch's points of material id, of
+ * nblk blocks over n points: their factors into sim->fb.scale, which the update reads as it
  * loads dF */
 static inline void fbar_gather_chunk(struct mpmc_sim_s *sim, int id, int ch, int nblk, int n) {
   const int b0 = ch * MPMC_BLOCK_CHUNK;
   const int b1 = b0 + MPMC_BLOCK_CHUNK < nblk ? b0 + MPMC_BLOCK_CHUNK : nblk;
   const int c0 = 4 * b0, c1 = 4 * b1 < n ? 4 * b1 : n;
-  MPMC_ISA(mpmc_fbar_gather_range)(sim, id, c0, c1, sim->fb_scale + c0); /* [q - c0] */
+  MPMC_ISA(mpmc_fbar_gather_range)(sim, id, c0, c1, sim->fb.scale + c0); /* [q - c0] */
 }
 
 /* bt = F b F^T (Voigt) in mpmc_push_forward's order (linalg.h), so the same bits per lane:

@@ -17,15 +17,15 @@ static int push_wall(mpmc_sim sim, const mpmc_wall *w, int *id) {
   sim->walls[sim->nwall] = *w;
   if (id) *id = sim->nwall;
   sim->nwall++;
-  sim->walls_dirty = 1;
+  sim->scr.walls_dirty = 1;
   return MPMC_SUCCESS;
 }
 
 static int check_kind_axis_side(mpmc_sim sim, int kind, int axis, int side) {
   MPMC_CHECK(kind >= MPMC_WALL_FIXED && kind <= MPMC_WALL_SEPARABLE, sim->ctx, MPMC_ERR_ARG,
              "wall kind = %d is not one of fixed (0), slip (1), separable (2)", kind);
-  MPMC_CHECK(axis >= 0 && axis < sim->dim, sim->ctx, MPMC_ERR_ARG, "wall axis = %d outside [0, %d)",
-             axis, sim->dim);
+  MPMC_CHECK(axis >= 0 && axis < sim->cfg.dim, sim->ctx, MPMC_ERR_ARG, "wall axis = %d outside [0, %d)",
+             axis, sim->cfg.dim);
   MPMC_CHECK(side == -1 || side == 1, sim->ctx, MPMC_ERR_ARG, "wall side = %d must be -1 or +1",
              side);
   return MPMC_SUCCESS;
@@ -60,8 +60,8 @@ int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, int kin
 int mpmc_sim_add_wall_face(mpmc_sim sim, int face, int kind, int *id) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(sim->grid.valid, sim->ctx, MPMC_ERR_STATE, "set the grid before adding face walls");
-  MPMC_CHECK(face >= 0 && face < 2 * sim->dim, sim->ctx, MPMC_ERR_ARG,
-             "face = %d outside [0, %d)", face, 2 * sim->dim);
+  MPMC_CHECK(face >= 0 && face < 2 * sim->cfg.dim, sim->ctx, MPMC_ERR_ARG,
+             "face = %d outside [0, %d)", face, 2 * sim->cfg.dim);
   const int axis = face / 2, hi = face % 2;
   return mpmc_sim_add_wall(sim, axis, hi ? 1 : -1, hi ? sim->grid.hi[axis] : sim->grid.lo[axis],
                            kind, id);
@@ -80,9 +80,9 @@ int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, int 
   MPMC_CHECK(lo && hi, sim->ctx, MPMC_ERR_ARG, "wall box lo/hi arrays are NULL");
   mpmc_wall w = {.active = 1, .kind = kind, .axis = axis, .side = side, .nodeset = -1};
   for (int a = 0; a < 3; ++a) {
-    w.lo[a] = a < sim->dim ? lo[a] : -INFINITY;
-    w.hi[a] = a < sim->dim ? hi[a] : INFINITY;
-    if (a < sim->dim)
+    w.lo[a] = a < sim->cfg.dim ? lo[a] : -INFINITY;
+    w.hi[a] = a < sim->cfg.dim ? hi[a] : INFINITY;
+    if (a < sim->cfg.dim)
       MPMC_CHECK(!isnan(lo[a]) && !isnan(hi[a]) && hi[a] >= lo[a], sim->ctx, MPMC_ERR_ARG,
                  "wall box axis %d: hi = %g must be >= lo = %g", a, hi[a], lo[a]);
   }
@@ -114,7 +114,7 @@ int mpmc_sim_remove_wall(mpmc_sim sim, int id) {
   MPMC_CHECK(id >= 0 && id < sim->nwall && sim->walls[id].active, sim->ctx, MPMC_ERR_ARG,
              "wall id %d does not exist or was removed", id);
   sim->walls[id].active = 0;
-  sim->walls_dirty = 1;
+  sim->scr.walls_dirty = 1;
   return MPMC_SUCCESS;
 }
 
@@ -124,12 +124,12 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
   if (!g->fixed) return MPMC_SUCCESS;
   const double tol = 1e-9 * g->h;
   for (size_t i = 0; i < g->nn; ++i) g->fixed[i] = 0;
-  free(sim->mirrors);
-  sim->mirrors = NULL;
-  sim->nmirror = 0;
+  free(sim->scr.mirrors);
+  sim->scr.mirrors = NULL;
+  sim->scr.nmirror = 0;
   if (sim->nwall > 0) {
-    sim->mirrors = malloc(sizeof *sim->mirrors * (size_t)sim->nwall);
-    MPMC_CHECK(sim->mirrors, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate wall mirrors");
+    sim->scr.mirrors = malloc(sizeof *sim->scr.mirrors * (size_t)sim->nwall);
+    MPMC_CHECK(sim->scr.mirrors, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate wall mirrors");
   }
   for (int wi = 0; wi < sim->nwall; ++wi) {
     const mpmc_wall *w = &sim->walls[wi];
@@ -146,15 +146,15 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
                  "wall %d: its node set %d no longer exists", wi, w->nodeset);
       const mpmc_set *ns = &sim->node_sets->s[w->nodeset];
       for (int q = 0; q < ns->n; ++q) {
-        const int *c = ns->idx + (size_t)q * sim->dim;
+        const int *c = ns->idx + (size_t)q * sim->cfg.dim;
         size_t node = 0;
-        for (int a = sim->dim - 1; a >= 0; --a) node = node * (size_t)g->n[a] + (size_t)(c[a] + MPMC_GHOST);
+        for (int a = sim->cfg.dim - 1; a >= 0; --a) node = node * (size_t)g->n[a] + (size_t)(c[a] + MPMC_GHOST);
         g->fixed[node] |= bits;
       }
       continue;
     }
     int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (int a = 0; a < sim->dim; ++a) {
+    for (int a = 0; a < sim->cfg.dim; ++a) {
       const double l = (w->lo[a] - g->origin[a]) * g->inv_h, u = (w->hi[a] - g->origin[a]) * g->inv_h;
       lo[a] = isinf(l) ? 0 : (int)ceil(l - tol * g->inv_h);
       hi[a] = isinf(u) ? g->n[a] - 1 : (int)floor(u + tol * g->inv_h);
@@ -167,18 +167,18 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
           g->fixed[(size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * (size_t)k)] |= bits;
     /* a fixed or slip half-space wall on a node plane mirrors its ghost nodes */
     int unbounded = 1;
-    for (int a = 0; a < sim->dim; ++a)
+    for (int a = 0; a < sim->cfg.dim; ++a)
       if (a != w->axis) unbounded &= isinf(w->lo[a]) && isinf(w->hi[a]);
     const double plane = (w->side < 0 ? w->hi[w->axis] : w->lo[w->axis]);
     const double s = (plane - g->origin[w->axis]) * g->inv_h;
     if (unbounded && w->kind != MPMC_WALL_SEPARABLE && fabs(s - round(s)) < 1e-9) {
-      mpmc_mirror *m = &sim->mirrors[sim->nmirror++];
+      mpmc_mirror *m = &sim->scr.mirrors[sim->scr.nmirror++];
       m->axis = w->axis;
       m->side = w->side;
       m->plane = (int)round(s);
       m->odd = w->kind == MPMC_WALL_FIXED ? 7u : 1u << w->axis;
     }
   }
-  sim->walls_dirty = 0;
+  sim->scr.walls_dirty = 0;
   return MPMC_SUCCESS;
 }

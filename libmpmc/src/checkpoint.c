@@ -122,7 +122,7 @@ static herr_t read_kept(hid_t loc, const char *name, hid_t memtype, size_t cols,
 
 /* Over MPI: the rows of /particles/x [k->total][dim] that lie in this rank's slab. */
 static int select_rows(hid_t g, mpmc_sim sim, ckpt_rows *k) {
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   hid_t ds = exists(g, "x") ? H5Dopen2(g, "x", H5P_DEFAULT) : -1;
   double *x = malloc(sizeof(double) * CKPT_CHUNK * (size_t)d);
   int cap = 0, err = ds >= 0 && x ? MPMC_SUCCESS
@@ -162,7 +162,7 @@ static double *adaptive_nodes(const mpmc_sim sim) {
   if (!sim->dd || sim->adr_own[0] < 0) return sim->adr_f;
   double *a = malloc(sim->adr_nf * sizeof *a);
   if (!a) return NULL;
-  const int ax = sim->adr_own[0], w = 1 + sim->dim;
+  const int ax = sim->adr_own[0], w = 1 + sim->cfg.dim;
   for (size_t i = 0; i < sim->grid.nn; ++i) {
     const long k = mpmc_grid_plane(&sim->grid, ax, i);
     const int mine = k >= sim->adr_own[1] && k < sim->adr_own[2];
@@ -176,7 +176,7 @@ static int write_config(hid_t f, const mpmc_sim sim) {
   hid_t g = H5Gcreate2(f, "config", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) return -1;
   const mpmc_grid *gr = &sim->grid;
-  const int ints[] = {sim->dim, sim->basis, sim->fbar, sim->solver, sim->nthreads, sim->force_dt};
+  const int ints[] = {sim->cfg.dim, sim->cfg.basis, sim->cfg.fbar, sim->cfg.solver, sim->cfg.nthreads, sim->cfg.force_dt};
   /* over MPI every rank writes the same attributes: the counts summed over the ranks (exact
    * in doubles below 2^53), the times the slowest rank's */
   double counts[3] = {(double)sim->stats.particle_steps, (double)sim->stats.return_maps,
@@ -190,21 +190,21 @@ static int write_config(hid_t f, const mpmc_sim sim) {
                            (int64_t)counts[2]};
   herr_t st = 0;
   st |= mpmc_h5_attr_write(g, "dim_basis_fbar_solver_nthreads_forcedt", H5T_NATIVE_INT, 6, ints);
-  st |= mpmc_h5_attr_write(g, "flip", H5T_NATIVE_DOUBLE, 1, &sim->flip);
-  st |= mpmc_h5_attr_write(g, "gravity", H5T_NATIVE_DOUBLE, 3, sim->gravity);
-  st |= mpmc_h5_attr_write(g, "damping", H5T_NATIVE_DOUBLE, 1, &sim->damping);
-  const double kd[2] = {sim->kdamp, sim->kd_ke}; /* kinetic damping: on, E_k of the last step */
+  st |= mpmc_h5_attr_write(g, "flip", H5T_NATIVE_DOUBLE, 1, &sim->cfg.flip);
+  st |= mpmc_h5_attr_write(g, "gravity", H5T_NATIVE_DOUBLE, 3, sim->cfg.gravity);
+  st |= mpmc_h5_attr_write(g, "damping", H5T_NATIVE_DOUBLE, 1, &sim->cfg.damping);
+  const double kd[2] = {sim->cfg.kdamp, sim->kd_ke}; /* kinetic damping: on, E_k of the last step */
   st |= mpmc_h5_attr_write(g, "kinetic_damping", H5T_NATIVE_DOUBLE, 2, kd);
   /* adaptive damping: zeta (0: off), c, the running sums; with the last step's nodal forces
    * the next step goes on as without the restart */
-  const double ad[4] = {sim->adr ? sim->adr_zeta : 0.0, sim->adr_c, sim->adr_sum[0],
+  const double ad[4] = {sim->cfg.adr ? sim->cfg.adr_zeta : 0.0, sim->adr_c, sim->adr_sum[0],
                         sim->adr_sum[1]};
   st |= mpmc_h5_attr_write(g, "adaptive_damping", H5T_NATIVE_DOUBLE, 4, ad);
-  if (sim->adr && sim->adr_nf) {
+  if (sim->cfg.adr && sim->adr_nf) {
     double *nodes = adaptive_nodes(sim);
     if (!nodes) return -1;
     st |= mpmc_h5_dataset_write(g, "adaptive_damping_nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                                sim->grid.nn, (size_t)(1 + sim->dim), nodes);
+                                sim->grid.nn, (size_t)(1 + sim->cfg.dim), nodes);
     if (nodes != sim->adr_f) free(nodes);
   }
   st |= mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &sim->time);
@@ -216,14 +216,14 @@ static int write_config(hid_t f, const mpmc_sim sim) {
   st |= mpmc_h5_attr_write(g, "stats_wall_seconds", H5T_NATIVE_DOUBLE, 1, secs);
   st |= mpmc_h5_attr_write(g, "stats_phase_seconds", H5T_NATIVE_DOUBLE, MPMC_PHASE_COUNT,
                            secs + 1);
-  int64_t sort[2] = {sim->sort_every, sim->sort_last}; /* interval, step of the last */
+  int64_t sort[2] = {sim->cfg.sort_every, sim->sort_last}; /* interval, step of the last */
   /* the axis the last sort ordered by and the last slab build's: whether the next step sorts
    * because the slab axis changed (sort.c, mpmc_sort_due) */
-  int axes[2] = {sim->sort_axis, sim->slab_axis};
+  int axes[2] = {sim->sort_axis, sim->scr.slab_axis};
   int rank, size;
   mpmc_io_ranks(sim, &rank, &size);
   if (size > 1) { /* each rank sorts its own points: every rank's, rank 0's as the attributes */
-    const int64_t mine[3] = {sim->sort_last, sim->sort_axis, sim->slab_axis};
+    const int64_t mine[3] = {sim->sort_last, sim->sort_axis, sim->scr.slab_axis};
     hid_t dxpl = mpmc_io_dxpl(sim);
     st |= mpmc_h5_rows_write(g, "rank_sort_last_sort_axis_slab_axis", H5T_STD_I64LE,
                              H5T_NATIVE_INT64, size, 3, rank, 1, mine, dxpl);
@@ -280,7 +280,7 @@ static int read_adaptive_nodes(hid_t f, mpmc_sim sim) {
   if (g < 0) return MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT, "checkpoint has no /config group");
   int err = MPMC_SUCCESS;
   if (exists(g, "adaptive_damping_nodes")) {
-    const size_t cols = (size_t)(1 + sim->dim), n = sim->grid.nn * cols;
+    const size_t cols = (size_t)(1 + sim->cfg.dim), n = sim->grid.nn * cols;
     double *a = malloc(n * sizeof *a);
     if (!a)
       err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate adaptive damping's node store");
@@ -320,12 +320,12 @@ static int read_rank_sort(hid_t f, mpmc_sim sim) {
   if (g >= 0) H5Gclose(g);
   MPMC_CHECK(st >= 0, sim->ctx, MPMC_ERR_FORMAT, "checkpoint /config/%s: unreadable", name);
   if (rows != size || size == 1) return MPMC_SUCCESS;
-  MPMC_CHECK(mine[0] >= -1 && mine[0] <= sim->stats.steps && mine[1] >= -1 && mine[1] < sim->dim &&
-                 mine[2] >= 0 && mine[2] < sim->dim,
+  MPMC_CHECK(mine[0] >= -1 && mine[0] <= sim->stats.steps && mine[1] >= -1 && mine[1] < sim->cfg.dim &&
+                 mine[2] >= 0 && mine[2] < sim->cfg.dim,
              sim->ctx, MPMC_ERR_FORMAT, "checkpoint /config/%s: bad row %d", name, rank);
   sim->sort_last = mine[0];
   sim->sort_axis = (int)mine[1];
-  sim->slab_axis = (int)mine[2];
+  sim->scr.slab_axis = (int)mine[2];
   return MPMC_SUCCESS;
 }
 
@@ -367,8 +367,8 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
     st |= mpmc_h5_attr_read(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
   H5Gclose(g);
   MPMC_CHECK(st >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint /config: missing or malformed attributes");
-  MPMC_CHECK(ints[0] == sim->dim, ctx, MPMC_ERR_FORMAT,
-             "checkpoint /config: dim = %d differs from the file's dim = %d", ints[0], sim->dim);
+  MPMC_CHECK(ints[0] == sim->cfg.dim, ctx, MPMC_ERR_FORMAT,
+             "checkpoint /config: dim = %d differs from the file's dim = %d", ints[0], sim->cfg.dim);
   MPMC_CALL(mpmc_sim_set_basis(sim, ints[1]));
   MPMC_CALL(mpmc_sim_set_fbar(sim, ints[2]));
   MPMC_CALL(mpmc_sim_set_solver(sim, ints[3]));
@@ -386,8 +386,8 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
   sim->adr_c = ad[1]; /* the estimate and, below, the last step's nodal forces: the next */
   sim->adr_sum[0] = ad[2]; /* step goes on as without the restart */
   sim->adr_sum[1] = ad[3];
-  if (sim->adr) MPMC_CALL(read_adaptive_nodes(f, sim));
-  for (int a = 0; a < sim->dim; ++a)
+  if (sim->cfg.adr) MPMC_CALL(read_adaptive_nodes(f, sim));
+  for (int a = 0; a < sim->cfg.dim; ++a)
     MPMC_CHECK(sim->grid.hi[a] == hi[a], ctx, MPMC_ERR_FORMAT,
                "checkpoint /config: grid axis %d does not hold whole cells (hi %g, rebuilt %g)", a,
                hi[a], sim->grid.hi[a]);
@@ -404,12 +404,12 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
   MPMC_CHECK(sort[0] >= 0 && sort[0] <= INT32_MAX && sort[1] >= -1 && sort[1] <= stats[0], ctx,
              MPMC_ERR_FORMAT, "checkpoint /config: bad sort_interval_last = [%lld, %lld]",
              (long long)sort[0], (long long)sort[1]);
-  sim->sort_every = (int)sort[0];
+  sim->cfg.sort_every = (int)sort[0];
   sim->sort_last = sort[1];
-  MPMC_CHECK(axes[0] >= -1 && axes[0] < sim->dim && axes[1] >= 0 && axes[1] < sim->dim, ctx,
+  MPMC_CHECK(axes[0] >= -1 && axes[0] < sim->cfg.dim && axes[1] >= 0 && axes[1] < sim->cfg.dim, ctx,
              MPMC_ERR_FORMAT, "checkpoint /config: bad sort_axis_slab_axis = [%d, %d]", axes[0], axes[1]);
   sim->sort_axis = axes[0];
-  sim->slab_axis = axes[1];
+  sim->scr.slab_axis = axes[1];
   return read_rank_sort(f, sim);
 }
 
@@ -769,7 +769,7 @@ static int read_walls(hid_t f, mpmc_sim sim, ckpt_rows *k) {
     free(ns);
   }
   sim->nwall = nw;
-  sim->walls_dirty = 1;
+  sim->scr.walls_dirty = 1;
   return MPMC_SUCCESS;
 }
 
@@ -815,7 +815,7 @@ static int write_set_group(hid_t f, const mpmc_sim sim, const char *gname,
 
 static int write_sets(hid_t f, const mpmc_sim sim) {
   if (write_set_group(f, sim, "sets", sim->sets, 1) < 0) return -1;
-  return write_set_group(f, sim, "node_sets", sim->node_sets, sim->dim);
+  return write_set_group(f, sim, "node_sets", sim->node_sets, sim->cfg.dim);
 }
 
 static int cmp_int(const void *a, const void *b) {
@@ -873,7 +873,7 @@ static int read_set_group(hid_t f, mpmc_sim sim, const char *gname, int ncomp,
 static int read_sets(hid_t f, mpmc_sim sim, ckpt_rows *k) {
   MPMC_CALL(read_set_group(f, sim, "sets", 1, k));
   /* checkpoints written before node sets existed have none */
-  return exists(f, "node_sets") ? read_set_group(f, sim, "node_sets", sim->dim, k) : MPMC_SUCCESS;
+  return exists(f, "node_sets") ? read_set_group(f, sim, "node_sets", sim->cfg.dim, k) : MPMC_SUCCESS;
 }
 
 /* ---- block: rigid bodies (contact_barrier.c) ---------------------------------------------- */
@@ -1003,7 +1003,7 @@ static int read_bodies(hid_t f, mpmc_sim sim, ckpt_rows *kr) {
       b->lo[a] = r[4 + a], b->hi[a] = r[7 + a], b->v[a] = r[10 + a];
       b->offset[a] = r[13 + a], b->reaction[a] = r[16 + a];
     }
-    if (b->kind != BODY_BOX && !(b->kind == BODY_POLYGON && sim->dim == 2 && b->nvert >= 3 &&
+    if (b->kind != BODY_BOX && !(b->kind == BODY_POLYGON && sim->cfg.dim == 2 && b->nvert >= 3 &&
                                  k + b->nvert <= nv)) {
       err = MPMC_ERROR(ctx, MPMC_ERR_FORMAT,
                        "checkpoint rigid body %ld: kind %d with %d vertices (%ld stored) is "
@@ -1290,8 +1290,8 @@ static int read_file(mpmc_context ctx, const void *comm, const char *path, hid_t
     free(m);
     return err;
   }
-  sim->prepared = 0;
-  sim->walls_dirty = 1;
+  sim->scr.prepared = 0;
+  sim->scr.walls_dirty = 1;
   *out = sim;
   if (meta) *meta = m;
   return MPMC_SUCCESS;

@@ -127,7 +127,7 @@ static void contact_params(const struct mpmc_sim_s *sim, double *dhat, double *k
     return;
   }
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const double h = sim->grid.h;
   double l = 0.5 * h;
   double sn[2] = {0.0, p->n}; /* the volumes' sum and the points, over the ranks over MPI */
@@ -177,7 +177,7 @@ int mpmc_contact_reserve_anchors(struct mpmc_sim_s *sim, mpmc_body *b, int n) {
 int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
   struct mpmc_bodies_s *B = sim->bodies;
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   MPMC_CALL(mpmc_particles_ensure(sim->ctx, p, &p->cforce, d, 0.0));
   double *restrict cf = p->cforce;
   const long nd = (long)p->n * d;
@@ -286,7 +286,7 @@ int mpmc_contact_update(struct mpmc_sim_s *sim, double dt) {
  * over MPI its global id (of the points with that gap, the least id; collective). */
 static double min_gap(const struct mpmc_sim_s *sim, const mpmc_body *b, int *point) {
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double gmin = INFINITY;
 #pragma omp parallel for schedule(static) reduction(min : gmin) if (p->n > CONTACT_PAR_MIN)
   for (int q = 0; q < p->n; ++q) {
@@ -323,7 +323,7 @@ void mpmc_contact_step(struct mpmc_sim_s *sim, int begin) {
 /* After a step: no point may have crossed into a body (the step that did it fails). */
 int mpmc_contact_check(struct mpmc_sim_s *sim) {
   const struct mpmc_bodies_s *B = sim->bodies;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double dhat, kappa;
   contact_params(sim, &dhat, &kappa);
   for (int bi = 0; bi < B->n; ++bi) {
@@ -363,7 +363,7 @@ double mpmc_contact_stable_dt(const struct mpmc_sim_s *sim) {
   for (int bi = 0; bi < B->n; ++bi) any |= B->b[bi].active;
   if (!any) return INFINITY;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double dhat, kappa;
   contact_params(sim, &dhat, &kappa);
   /* every point but those about to touch has the design ratio's stiffness factor; and
@@ -452,7 +452,7 @@ int mpmc_sim_add_rigid_box(mpmc_sim sim, const double *lo, const double *hi, dou
   MPMC_CHECK(lo && hi, sim->ctx, MPMC_ERR_ARG, "rigid box lo/hi arrays are NULL");
   MPMC_CALL(check_mu(sim, mu));
   mpmc_body b = {.active = 1, .kind = BODY_BOX, .mu = mu};
-  for (int a = 0; a < sim->dim; ++a) {
+  for (int a = 0; a < sim->cfg.dim; ++a) {
     MPMC_CHECK(isfinite(lo[a]) && isfinite(hi[a]) && hi[a] > lo[a], sim->ctx, MPMC_ERR_ARG,
                "rigid box axis %d: hi = %g must exceed lo = %g (both finite)", a, hi[a], lo[a]);
     b.lo[a] = lo[a];
@@ -470,8 +470,8 @@ int mpmc_sim_add_rigid_box(mpmc_sim sim, const double *lo, const double *hi, dou
 int mpmc_sim_add_rigid_polygon(mpmc_sim sim, int nvert, const double *xy, double mu, int *id) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
-  MPMC_CHECK(sim->dim == 2, ctx, MPMC_ERR_ARG,
-             "rigid polygons are 2D only (dim = %d): use mpmc_sim_add_rigid_box", sim->dim);
+  MPMC_CHECK(sim->cfg.dim == 2, ctx, MPMC_ERR_ARG,
+             "rigid polygons are 2D only (dim = %d): use mpmc_sim_add_rigid_box", sim->cfg.dim);
   MPMC_CHECK(nvert >= 3, ctx, MPMC_ERR_ARG, "polygon needs nvert >= 3 vertices (got %d)", nvert);
   MPMC_CHECK(xy, ctx, MPMC_ERR_ARG, "polygon vertex array xy is NULL");
   MPMC_CALL(check_mu(sim, mu));
@@ -520,10 +520,10 @@ int mpmc_sim_set_rigid_velocity(mpmc_sim sim, int id, const double *v) {
   mpmc_body *b = NULL;
   MPMC_CALL(get_body(sim, id, &b));
   MPMC_CHECK(v, sim->ctx, MPMC_ERR_ARG, "rigid body velocity array is NULL");
-  for (int a = 0; a < sim->dim; ++a)
+  for (int a = 0; a < sim->cfg.dim; ++a)
     MPMC_CHECK(isfinite(v[a]), sim->ctx, MPMC_ERR_ARG,
                "rigid body velocity component %d = %g is not finite", a, v[a]);
-  for (int a = 0; a < sim->dim; ++a) b->v[a] = v[a];
+  for (int a = 0; a < sim->cfg.dim; ++a) b->v[a] = v[a];
   return MPMC_SUCCESS;
 }
 
@@ -533,7 +533,7 @@ int mpmc_sim_get_rigid_offset(const mpmc_sim sim, int id, double *offset) {
   mpmc_body *b = NULL;
   MPMC_CALL(get_body(sim, id, &b));
   MPMC_CHECK(offset, sim->ctx, MPMC_ERR_ARG, "offset array is NULL");
-  for (int a = 0; a < sim->dim; ++a) offset[a] = b->offset[a];
+  for (int a = 0; a < sim->cfg.dim; ++a) offset[a] = b->offset[a];
   return MPMC_SUCCESS;
 }
 
@@ -546,7 +546,7 @@ int mpmc_sim_get_rigid_reaction(const mpmc_sim sim, int id, double *f) {
   mpmc_body *b = NULL;
   MPMC_CALL(get_body(sim, id, &b));
   MPMC_CHECK(f, sim->ctx, MPMC_ERR_ARG, "reaction array is NULL");
-  for (int a = 0; a < sim->dim; ++a) f[a] = b->reaction[a];
+  for (int a = 0; a < sim->cfg.dim; ++a) f[a] = b->reaction[a];
   return MPMC_SUCCESS;
 }
 

@@ -47,7 +47,7 @@ void mpmc_damping_apply(double alpha, double *restrict f, const double *restrict
  * restart. */
 void mpmc_kinetic_damping(struct mpmc_sim_s *sim) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double e = 0.0;
 #pragma omp parallel for reduction(+ : e) schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {
@@ -61,14 +61,14 @@ void mpmc_kinetic_damping(struct mpmc_sim_s *sim) {
     const size_t nv = (size_t)p->n * (size_t)d;
 #pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
     for (size_t k = 0; k < nv; ++k) p->v[k] = 0.0;
-    sim->v2max = 0.0; /* G2P's max |v|^2 (stability.c) */
+    sim->scr.v2max = 0.0; /* G2P's max |v|^2 (stability.c) */
     e = 0.0;
   }
   sim->kd_ke = e;
 }
 
 int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow) {
-  const size_t need = sim->grid.nn * (size_t)(1 + sim->dim);
+  const size_t need = sim->grid.nn * (size_t)(1 + sim->cfg.dim);
   if (sim->adr_nf != need) { /* a new grid: no node held mass in the last step */
     double *f = realloc(sim->adr_f, need * sizeof *f);
     MPMC_CHECK(f, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate adaptive damping's node store");
@@ -76,11 +76,11 @@ int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow) {
     sim->adr_f = f;
     sim->adr_nf = need;
   }
-  if (sim->adr_nrows < (size_t)nrow) {
-    double *r = realloc(sim->adr_rows, 2 * (size_t)nrow * sizeof *r);
+  if (sim->scr.adr_nrows < (size_t)nrow) {
+    double *r = realloc(sim->scr.adr_rows, 2 * (size_t)nrow * sizeof *r);
     MPMC_CHECK(r, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate adaptive damping's row sums");
-    sim->adr_rows = r;
-    sim->adr_nrows = (size_t)nrow;
+    sim->scr.adr_rows = r;
+    sim->scr.adr_nrows = (size_t)nrow;
   }
   sim->adr_own[0] = -1;
 #ifdef MPMC_HAVE_MPI
@@ -99,8 +99,8 @@ int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow) {
 void mpmc_adaptive_damping_finish(struct mpmc_sim_s *sim, long nrow) {
   double num = 0.0, den = 0.0;
   for (long r = 0; r < nrow; ++r) {
-    num += sim->adr_rows[2 * r];
-    den += sim->adr_rows[2 * r + 1];
+    num += sim->scr.adr_rows[2 * r];
+    den += sim->scr.adr_rows[2 * r + 1];
   }
   double both[2] = {num, den};
   mpmc_dd_sum(sim, both, 2); /* MPI: over the ranks, in rank order (the same c on each) */
@@ -110,5 +110,5 @@ void mpmc_adaptive_damping_finish(struct mpmc_sim_s *sim, long nrow) {
   sim->adr_sum[1] = ADR_KEEP * sim->adr_sum[1] + (1.0 - ADR_KEEP) * den;
   if (!(sim->adr_sum[1] > 0.0)) return; /* no motion yet: c stays */
   const double w2 = sim->adr_sum[0] / sim->adr_sum[1];
-  sim->adr_c = w2 > 0.0 ? 2.0 * sim->adr_zeta * sqrt(w2) : 0.0;
+  sim->adr_c = w2 > 0.0 ? 2.0 * sim->cfg.adr_zeta * sqrt(w2) : 0.0;
 }

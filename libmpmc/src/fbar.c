@@ -17,24 +17,37 @@
  * the grid of spacing 2h (nodes x = lo, lo + 2h, ...) for linear and uGIMP, linear hats
  * centred on the cells for quadratic B-splines, quadratic B-splines centred on the cells for
  * cubic ones.  With w the weights of that space the formulas above are unchanged.
- * V_p is the volume at t^n.  In a step the scatter runs fused into the transfers, which have
- * the points at x^n and, but in the stable form, the weights at hand: in the paper, total and
- * anchored forms P2G adds V_i to the node records (slot MPMC_VSLOT, beside the mass) and G2P
- * (V J)_i to fbj, one value per node; in the stable form G2P adds both to fb, in pairs.  G2P
- * sets grid.fb_done and keeps what the gather needs of x^n (the points have moved by then): in the
- * paper, total and anchored forms the weights, as the basis's offsets and first nodes (xoff,
- * xnode; transfer.h, mpmc_kept_weights4), in the stable form the positions (xn).
- * Called on its own (tests) the projection scatters here and gathers, both at x,
- * recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).  The scatter leaves
- * Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
+ * V_p is the volume at t^n.
+ *
+ * The life of F-bar's state in a step (sim->fb, mpmc_fbar_state; step.c calls in this order):
+ *   prepare  mpmc_sim_prepare -> mpmc_fbar_prepare: the points' Jbar (and Janc) and, for the
+ *            form in use, the nodal sums, zeroed, and the arrays that keep x^n; before each
+ *            step mpmc_fbar_reserve makes room in them for every point.
+ *   clear    mpmc_fbar_clear(BOX): the last step's active box of fb and fbj to zero (the
+ *            grid's own clear zeroes the records, their MPMC_VSLOT with them).
+ *   P2G      (p2g.c) the paper, total and anchored forms: V_i into the records' MPMC_VSLOT
+ *            beside the mass (the points are at x^n there, as the projection has them).
+ *   G2P      (g2p.c) the scatter, fused, with the weights at hand: (V J)_i into fbj, one
+ *            value per node, or in the stable form both sums into fb, in pairs (on private
+ *            copies, priv, when P2G ran so); keeps x^n, as the weights' offsets and first
+ *            nodes (xoff, xnode; transfer.h, mpmc_kept_weights4), or in the stable form as
+ *            positions (xn); sets scattered.  Over MPI the halo sums follow (mpi.c).
+ *   F-bar    mpmc_fbar: the nodal average into fbj, then the gather of every point with its
+ *            dF scaled, or, when every material's update runs the gather itself, deferred.
+ *   stress   (stress_j2.c, stress_blocks.c through batch4.h) the deferred gather chunk by
+ *            chunk into scale (mpmc_fbar_gather_range), dF scaled as it is loaded;
+ *            stress_update.c clears deferred.
+ * Called on its own (tests), with no scatter since the clear, the projection scatters here
+ * and gathers, both at x, recovering V_p as V0 J^{n+1} / dJ (G2P has already updated J).
+ * The scatter leaves Jbar^n dJ in Jbar for the gather, which replaces it with Pi.
  * Dilatant plastic flow (the frictional models with psi > 0) changes a point's volume with
  * no elastic volume change; projecting it with the rest made a plastic dilation at one point
  * compress the elastic volume of its neighbours and a dilating shear band fed itself until
  * the run blew up.  Where such models exist (p->Jp), each point scatters j / Jp, Jp its
  * plastic volume ratio J / J_e (material_frictional.c), and takes Jp x Pi: the projection
  * smooths the volume change that is not plastic, and a point's plastic dilation stays its own.
- * Touches nothing but dF (handed to the material), Jbar, the grid's fb and fbj and the
- * records' MPMC_VSLOT. */
+ * Touches nothing but dF (handed to the material), Jbar, its own state and the records'
+ * MPMC_VSLOT. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -53,7 +66,7 @@ MPMC_ALWAYS_INLINE mpmc_v2d scatter_values(mpmc_sim sim, const int DIM, int q) {
   const double Vn = p->vol0[q] * p->J[q] / dJ;
   const double jd = p->Jbar[q] * dJ;
   /* no step to measure the travel: the anchored form re-anchors fully (Algorithm 1's) */
-  const double j = mpmc_fbar_j(sim->fbar == MPMC_FBAR_ANCHORED, sim->fbar, p, q, dJ, jd, INFINITY);
+  const double j = mpmc_fbar_j(sim->cfg.fbar == MPMC_FBAR_ANCHORED, sim->cfg.fbar, p, q, dJ, jd, INFINITY);
   p->Jbar[q] = jd;
   return (mpmc_v2d){Vn, p->Jp ? Vn * j / p->Jp[q] : Vn * j};
 }
@@ -64,7 +77,7 @@ MPMC_ALWAYS_INLINE void scatter_point(mpmc_sim sim, const int DIM, const int BAS
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int S = mpmc_stencil(BASIS);
-  double *restrict rec = g->node, *restrict fj = g->fbj;
+  double *restrict rec = g->node, *restrict fj = sim->fb.fbj;
   mpmc_pw4 t; /* lane 0 */
   mpmc_point_weights1(DIM, BASIS, 0, 0, g, p->x, p->lp, q, &t);
   const mpmc_v2d vv = scatter_values(sim, DIM, q);
@@ -139,11 +152,10 @@ MPMC_ALWAYS_INLINE double projection_scale(mpmc_particles *p, const int DIM, int
  * acc = sum_k wz_k (sum_j wy_j J_row(j,k)), one multiply-add per row and one per plane of
  * rows, and Pi = sum_i wx_i acc_i (gather_dot); wy, wz the point's 1D weights (ws doubles
  * apart). */
-MPMC_ALWAYS_INLINE void gather_rows(const mpmc_grid *g, const int DIM, const int BASIS,
-                                    size_t node0, const double *wy, const double *wz,
-                                    const int ws, mpmc_b4d *accp) {
+MPMC_ALWAYS_INLINE void gather_rows(const mpmc_grid *g, const double *restrict jb, const int DIM,
+                                    const int BASIS, size_t node0, const double *wy,
+                                    const double *wz, const int ws, mpmc_b4d *accp) {
   const int S = mpmc_stencil(BASIS);
-  const double *restrict jb = g->fbj;
   const size_t sy = (size_t)g->n[0], sz = (size_t)g->n[0] * (size_t)g->n[1];
   mpmc_b4d acc = {0.0, 0.0, 0.0, 0.0};
   for (int k = 0; k < (DIM == 3 ? S : 1); ++k) {
@@ -177,20 +189,20 @@ MPMC_ALWAYS_INLINE double gather_scale(mpmc_sim sim, const int DIM, const int BA
   if (xs)
     mpmc_point_weights1(DIM, BASIS, 0, 0, g, xs, p->lp, q, &t);
   else
-    mpmc_kept_weights1(DIM, BASIS, g, p, q, &t);
+    mpmc_kept_weights1(DIM, BASIS, g, &sim->fb, p->lp, q, &t);
   mpmc_b4d acc;
-  gather_rows(g, DIM, BASIS, (size_t)t.node0[0], &t.w[1][0][0], &t.w[2][0][0], 4, &acc);
+  gather_rows(g, sim->fb.fbj, DIM, BASIS, (size_t)t.node0[0], &t.w[1][0][0], &t.w[2][0][0], 4, &acc);
   return projection_scale(p, DIM, q, gather_dot(BASIS, &t.w[0][0][0], 4, &acc), inv);
 }
 
 /* The projected Jacobians pi of the four points of t (lanes), each lane with the same
  * operations as one point alone (same bits): the row sums point by point, then, with them
  * transposed, gather_dot as a vector. */
-MPMC_ALWAYS_INLINE void gather_pi4(const mpmc_grid *g, const int DIM, const int BASIS,
-                                   const mpmc_pw4 *t, mpmc_b4d *pip) {
+MPMC_ALWAYS_INLINE void gather_pi4(const mpmc_grid *g, const double *restrict jb, const int DIM,
+                                   const int BASIS, const mpmc_pw4 *t, mpmc_b4d *pip) {
   mpmc_b4d a[4];
   for (int l = 0; l < 4; ++l)
-    gather_rows(g, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l], 4, &a[l]);
+    gather_rows(g, jb, DIM, BASIS, (size_t)t->node0[l], &t->w[1][0][l], &t->w[2][0][l], 4, &a[l]);
   /* c[i] = (a[0][i], .., a[3][i]): lanes the points, as t's weights */
   mpmc_b4d c[4];
   mpmc_transpose4(a, c);
@@ -231,7 +243,7 @@ MPMC_ALWAYS_INLINE void gather_scale4(mpmc_sim sim, const int DIM, const int BAS
   mpmc_particles *p = &sim->p;
   const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
   mpmc_b4d pi;
-  gather_pi4(&sim->grid, DIM, BASIS, t, &pi);
+  gather_pi4(&sim->grid, sim->fb.fbj, DIM, BASIS, t, &pi);
   gather_finish4(p, DIM, q, &pi, &inv, scale);
 }
 
@@ -244,8 +256,8 @@ MPMC_ALWAYS_INLINE void gather_scale8(mpmc_sim sim, const int DIM, const int BAS
   const mpmc_b4d inv0 = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
   const mpmc_b4d inv1 = 1.0 / *(const mpmc_b4du *)(p->Jbar + q + 4);
   mpmc_b4d pi0, pi1;
-  gather_pi4(&sim->grid, DIM, BASIS, &t[0], &pi0);
-  gather_pi4(&sim->grid, DIM, BASIS, &t[1], &pi1);
+  gather_pi4(&sim->grid, sim->fb.fbj, DIM, BASIS, &t[0], &pi0);
+  gather_pi4(&sim->grid, sim->fb.fbj, DIM, BASIS, &t[1], &pi1);
   gather_finish4(p, DIM, q, &pi0, &inv0, scale);
   gather_finish4(p, DIM, q + 4, &pi1, &inv1, scale + 4);
 }
@@ -253,7 +265,7 @@ MPMC_ALWAYS_INLINE void gather_scale8(mpmc_sim sim, const int DIM, const int BAS
 MPMC_ALWAYS_INLINE void scatter_stable_point(mpmc_sim sim, const int DIM, const int BASIS, int q) {
   mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
-  double *restrict fb = g->fb;
+  double *restrict fb = sim->fb.fb;
   mpmc_spw sp;
   mpmc_stable_weights(DIM, BASIS, g, p->x + (size_t)q * DIM, &sp);
   const mpmc_v2d vv = scatter_values(sim, DIM, q);
@@ -264,7 +276,7 @@ MPMC_ALWAYS_INLINE double gather_stable_scale(mpmc_sim sim, const int DIM, const
                                               const double *xs, int q) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
-  const double *restrict jb = g->fbj;
+  const double *restrict jb = sim->fb.fbj;
   const double inv = 1.0 / p->Jbar[q];
   mpmc_spw sp;
   mpmc_stable_weights(DIM, BASIS, g, xs + (size_t)q * DIM, &sp);
@@ -280,7 +292,7 @@ MPMC_ALWAYS_INLINE void gather_stable_scale4(mpmc_sim sim, const int DIM, const 
                                              const double *xs, int q, double *scale) {
   const mpmc_grid *g = &sim->grid;
   mpmc_particles *p = &sim->p;
-  const double *restrict jb = g->fbj;
+  const double *restrict jb = sim->fb.fbj;
   const int S = mpmc_stable_stencil(BASIS), idx[4] = {q, q + 1, q + 2, q + 3};
   const mpmc_b4d inv = 1.0 / *(const mpmc_b4du *)(p->Jbar + q);
   mpmc_spw4 sp;
@@ -315,7 +327,7 @@ MPMC_ALWAYS_INLINE void gather_weights4(mpmc_sim sim, const int D, const int B, 
   if (xs)
     mpmc_point_weights4(D, B, 0, 0, &sim->grid, xs, sim->p.lp, idx, t);
   else
-    mpmc_kept_weights4(D, B, &sim->grid, &sim->p, idx[0], t);
+    mpmc_kept_weights4(D, B, &sim->grid, &sim->fb, sim->p.lp, idx[0], t);
 }
 
 /* one point's factor in either form (ST: the stable one, which takes x^n from xs) */
@@ -387,9 +399,9 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
 /* scatter by the slabs of this step's P2G (positions unchanged since): race-free by parity */
 #define FBAR_KERNELS(D, B)                                                                   \
   static void scatter_##D##_##B(mpmc_sim sim) {                                              \
-    const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
+    const int *restrict order = sim->scr.order, *restrict start = sim->scr.slab_start;       \
     for (int colour = 0; colour < 2; ++colour) {                                             \
-      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->scr.slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
       MPMC_SLABS_OF(sim, colour, sl)                                                         \
         for (int k = start[sl]; k < start[sl + 1]; ++k) scatter_point(sim, D, B, order[k]);  \
     }                                                                                        \
@@ -407,17 +419,17 @@ MPMC_ALWAYS_INLINE void gather_points(mpmc_sim sim, const int D, const int B, co
   /* the deferred gather of points q0 .. q1 - 1 of material id (after G2P: x^n in xn, or the \
    * weights at x^n kept) */                                                                 \
   static void gather_range_##D##_##B(mpmc_sim sim, int id, int q0, int q1, double *scale) {  \
-    if (sim->fbar == MPMC_FBAR_STABLE)                                                       \
-      gather_points(sim, D, B, 1, sim->p.xn, id, q0, q1, scale);                             \
+    if (sim->cfg.fbar == MPMC_FBAR_STABLE)                                                   \
+      gather_points(sim, D, B, 1, sim->fb.xn, id, q0, q1, scale);                             \
     else                                                                                     \
       gather_points(sim, D, B, 0, (const double *)NULL, id, q0, q1, scale);                  \
   }                                                                                          \
   /* the stable form's supports reach no further than the cubic B-spline's (nodes c - 1 ..  \
    * c + 2 of a point in cell c): the slabs keep same-coloured ones apart all the same */    \
   static void scatter_stable_##D##_##B(mpmc_sim sim) {                                       \
-    const int *restrict order = sim->order, *restrict start = sim->slab_start;               \
+    const int *restrict order = sim->scr.order, *restrict start = sim->scr.slab_start;       \
     for (int colour = 0; colour < 2; ++colour) {                                             \
-      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->scr.slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
       MPMC_SLABS_OF(sim, colour, sl)                                                         \
         for (int k = start[sl]; k < start[sl + 1]; ++k)                                      \
           scatter_stable_point(sim, D, B, order[k]);                                         \
@@ -430,35 +442,36 @@ MPMC_KERNELS(FBAR_KERNELS)
  * the widest; the stable form's spaces reach no further; t302 checks it).
  * defer: the step's call.  When every material's update runs the gather itself
  * (ops->gathers_fbar: every built-in model, not a user material), the gather is left to it
- * (grid.fb_gather; stress_j2.c, stress_blocks.c's MPMC_BLOCKS): each thread gathers its
- * points' factors into sim->fb_scale (allocated here) just before it updates
+ * (sim->fb.deferred; stress_j2.c, stress_blocks.c's MPMC_BLOCKS): each thread gathers its
+ * points' factors into sim->fb.scale (allocated here) just before it updates
  * them, and the update scales dF as it loads it, so dF is read once and written never
  * instead of read, scaled, written and read again (the landslide's points do not fit in the
  * cache: a pass less over 311,250 of them).  Same bits either way. */
 int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   mpmc_grid *g = &sim->grid;
-  const int stable = sim->fbar == MPMC_FBAR_STABLE;
+  const int stable = sim->cfg.fbar == MPMC_FBAR_STABLE;
   for (int m = 0; m < sim->nmat && defer; ++m) defer = sim->mats[m].ops->gathers_fbar;
   /* x^n: after G2P, which has moved the points, as it kept it (xn, or the weights: NULL) */
-  const double *xs = !g->fb_done ? sim->p.x : stable ? sim->p.xn : NULL;
-  if (!g->fb_done) { /* called on its own, not after a step's G2P: scatter here */
-    mpmc_grid_clear_fb_active(g);
+  mpmc_fbar_state *f = &sim->fb;
+  const double *xs = !f->scattered ? sim->p.x : stable ? f->xn : NULL;
+  if (!f->scattered) { /* called on its own, not after a step's G2P: scatter here */
+    mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_VOLUMES);
     if (stable)
       MPMC_KERNEL_CALL(scatter_stable_, sim, sim);
     else
       MPMC_KERNEL_CALL(scatter_, sim, sim);
   }
-  g->fb_done = 0;
+  f->scattered = 0;
   /* nodal volume average (Algorithm 1 step 3) into fbj, row by row: (V J)_i from fb's pairs
    * (stable form) or fbj itself, V_i from fb or the records */
   const long nrow = mpmc_grid_active_rows(g);
   const long box = (long)(g->act_hi[0] - g->act_lo[0]);
-  const double *restrict fb = g->fb, *restrict rec = g->node;
+  const double *restrict fb = f->fb, *restrict rec = g->node;
 #pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
     size_t len;
     const size_t first = mpmc_grid_active_row(g, r, &len);
-    double *fj = g->fbj + first;
+    double *fj = f->fbj + first;
     if (stable) {
       const double *f = fb + 2 * first;
       for (size_t i = 0; i < len; ++i) fj[i] = f[2 * i] > 0.0 ? f[2 * i + 1] / f[2 * i] : 0.0;
@@ -470,16 +483,16 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
       }
     }
   }
-  if (defer && sim->p.n > sim->cap_fb_scale) {
-    double *a = realloc(sim->fb_scale, sizeof(double) * (size_t)sim->p.n);
+  if (defer && sim->p.n > f->cap_scale) {
+    double *a = realloc(f->scale, sizeof(double) * (size_t)sim->p.n);
     MPMC_CHECK(a, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate F-bar's factors of %d points",
                sim->p.n);
-    sim->fb_scale = a;
-    sim->cap_fb_scale = sim->p.n;
+    f->scale = a;
+    f->cap_scale = sim->p.n;
   }
-  g->fb_gather = defer;
+  f->deferred = defer;
   if (defer)
-    ; /* the material update gathers (mpmc_fbar_gather_range) into sim->fb_scale */
+    ; /* the material update gathers (mpmc_fbar_gather_range) into f->scale */
   else if (stable)
     MPMC_KERNEL_CALL(gather_stable_, sim, sim, xs);
   else
@@ -487,9 +500,131 @@ int MPMC_ISA(mpmc_fbar)(mpmc_sim sim, int defer) {
   return MPMC_SUCCESS;
 }
 
-/* The deferred gather (grid.fb_gather) of material id's points among q0 .. q1 - 1: their
+/* The deferred gather (sim->fb.deferred) of material id's points among q0 .. q1 - 1: their
  * projected Jacobians into Jbar, and into scale[q - q0] the factor of their dF (eq 27), which
  * the caller applies as it loads dF; the other points' entries are left alone. */
 void MPMC_ISA(mpmc_fbar_gather_range)(mpmc_sim sim, int id, int q0, int q1, double *scale) {
   MPMC_KERNEL_CALL(gather_range_, sim, sim, id, q0, q1, scale);
 }
+
+#if defined(MPMC_ISA_BASELINE) /* F-bar's state: once, not per instruction set */
+/* Free *a and set it NULL. */
+static void drop(void *a) {
+  void **pa = a;
+  free(*pa);
+  *pa = NULL;
+}
+
+/* The state's arrays for the sim's form, and the points' Jbar (J where F-bar starts with the
+ * run) and, for the anchored form, Janc (anchored to the Jbar at hand); what the form does
+ * not use freed. */
+int mpmc_fbar_prepare(mpmc_sim sim) {
+  mpmc_context ctx = sim->ctx;
+  mpmc_particles *p = &sim->p;
+  mpmc_fbar_state *f = &sim->fb;
+  const int form = sim->cfg.fbar, stable = form == MPMC_FBAR_STABLE;
+  if (form && !p->Jbar) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
+    for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
+  }
+  if (form == MPMC_FBAR_ANCHORED && !p->Janc) {
+    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Janc, 1, 1.0));
+    memcpy(p->Janc, p->Jbar, sizeof(double) * (size_t)p->n);
+  } else if (form != MPMC_FBAR_ANCHORED) {
+    drop(&p->Janc);
+  }
+  if (f->nn != sim->grid.nn || !form) { /* a new grid (or none needed): new sums */
+    drop(&f->fb);
+    drop(&f->fbj);
+    drop(&f->priv);
+    f->cap_priv = 0;
+    f->nn = 0;
+  }
+  if (!stable) drop(&f->fb);
+  if (!stable) drop(&f->xn);
+  if (!form || stable) {
+    drop(&f->xoff);
+    drop(&f->xnode);
+  }
+  if (!form) {
+    drop(&f->scale);
+    f->cap_scale = 0;
+    f->cap = 0;
+    f->scattered = f->deferred = 0;
+    return MPMC_SUCCESS;
+  }
+  const size_t nn = sim->grid.nn;
+  if (stable) MPMC_CALL(mpmc_grid_array(ctx, &f->fb, nn * 2));
+  MPMC_CALL(mpmc_grid_array(ctx, &f->fbj, nn + 4)); /* the gather reads 4 from a row start */
+  f->nn = nn;
+  mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_ALL); /* a grid set anew has its active box anew */
+  if ((stable && !f->xn) || (!stable && !f->xoff)) f->cap = 0; /* the form's kept arrays anew */
+  return mpmc_fbar_reserve(sim);
+}
+
+/* Grow *a to n entries of size bytes (contents not kept: scratch within a step). */
+static int regrow(mpmc_context ctx, void *a, size_t n, size_t size) {
+  void **pa = a;
+  free(*pa);
+  *pa = malloc(n * size);
+  MPMC_CHECK(*pa, ctx, MPMC_ERR_MEMORY, "cannot allocate F-bar's arrays for %zu points", n);
+  return MPMC_SUCCESS;
+}
+
+int mpmc_fbar_reserve(mpmc_sim sim) {
+  mpmc_fbar_state *f = &sim->fb;
+  const int cap = sim->p.cap;
+  if (!sim->cfg.fbar || f->cap >= cap) return MPMC_SUCCESS;
+  const size_t d = (size_t)sim->cfg.dim, n = (size_t)cap;
+  if (sim->cfg.fbar == MPMC_FBAR_STABLE) {
+    MPMC_CALL(regrow(sim->ctx, &f->xn, d * n, sizeof(double)));
+  } else {
+    MPMC_CALL(regrow(sim->ctx, &f->xoff, d * n, sizeof(double)));
+    MPMC_CALL(regrow(sim->ctx, &f->xnode, n, sizeof(int)));
+  }
+  f->cap = cap;
+  return MPMC_SUCCESS;
+}
+
+/* Zero the sums, and with the points' volumes too (vslot: the records' MPMC_VSLOT, which P2G
+ * fills in a step), over the active box's rows, on all threads; every form's supports lie
+ * in the box (t302). */
+static void clear_rows(mpmc_sim sim, int vslot) {
+  mpmc_grid *g = &sim->grid;
+  double *node = g->node, *fb = sim->fb.fb, *fbj = sim->fb.fbj;
+  const long nrow = mpmc_grid_active_rows(g);
+  const long box = (long)(g->act_hi[0] - g->act_lo[0]);
+#pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
+  for (long r = 0; r < nrow; ++r) {
+    size_t len;
+    const size_t first = mpmc_grid_active_row(g, r, &len);
+    if (vslot)
+      for (size_t i = first; i < first + len; ++i) node[i * MPMC_NREC + MPMC_VSLOT] = 0.0;
+    if (fb) memset(fb + first * 2, 0, len * 2 * sizeof(double));
+    if (fbj) memset(fbj + first, 0, len * sizeof(double));
+  }
+}
+
+void mpmc_fbar_clear(mpmc_sim sim, int what) {
+  mpmc_fbar_state *f = &sim->fb;
+  if (what == MPMC_FBAR_CLEAR_ALL) {
+    if (f->fb) memset(f->fb, 0, f->nn * 2 * sizeof(double));
+    if (f->fbj) memset(f->fbj, 0, f->nn * sizeof(double));
+  } else if (f->fbj) {
+    clear_rows(sim, what == MPMC_FBAR_CLEAR_VOLUMES);
+  }
+  f->scattered = 0;
+}
+
+void mpmc_fbar_free(mpmc_sim sim) {
+  mpmc_fbar_state *f = &sim->fb;
+  drop(&f->fb);
+  drop(&f->fbj);
+  drop(&f->priv);
+  drop(&f->xn);
+  drop(&f->xoff);
+  drop(&f->xnode);
+  drop(&f->scale);
+  memset(f, 0, sizeof *f);
+}
+#endif

@@ -74,9 +74,9 @@ MPMC_ALWAYS_INLINE void fb_scatter(const int DIM, const int BASIS, const int WID
  * stencil's node records are factored by axis (rows along x, then planes, then z; below),
  * all whole-vector multiply-adds in record layout; the components are picked out once.
  * FB = 1 (3: in rows of four, fb_scatter): also scatter V^n j of Algorithm 1 step 3 into fb
- * (the grid's fbj, one value per node) with the same weights (the points are still at x^n;
+ * (F-bar's fbj, one value per node) with the same weights (the points are still at x^n;
  * V^n itself P2G scattered into the records' MPMC_VSLOT); FB = 2 (the stable form): scatter
- * V^n and V^n J into fb (the grid's fb, pairs) with the weights of its own space
+ * V^n and V^n J into fb (F-bar's fb, pairs) with the weights of its own space
  * (transfer.h); either way the caller runs the points in slab colours.  FB + 4 (5, 7): FB's
  * scatter in the anchored form, j the point's anchored Jacobian (transfer.h, mpmc_anchor),
  * a kernel of its own so that the other forms do not pay for it. */
@@ -176,7 +176,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
       __asm__("" : "+x"(travel));
 #endif
     }
-    vv = (mpmc_v2d){Vn, Vn * mpmc_fbar_j(FB & 4, sim->fbar, p, q, dJ, jd, travel)};
+    vv = (mpmc_v2d){Vn, Vn * mpmc_fbar_j(FB & 4, sim->cfg.fbar, p, q, dJ, jd, travel)};
     if (p->Jp) vv[1] /= p->Jp[q]; /* the volume change that is not plastic (fbar.c) */
     p->Jbar[q] = jd;
   }
@@ -229,7 +229,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
 /* Without F-bar the points run in index order, split evenly among the threads; with it by
  * the slabs of this step's P2G (positions unchanged since) in two colours, so that the
  * fused scatter is race-free (through the slab order, or by index where the points are stored
- * in that order, sim->order_ident: the same sequence, 7 instructions a point fewer on the
+ * in that order, sim->scr.order_ident: the same sequence, 7 instructions a point fewer on the
  * linear column), or, when P2G scattered into one grid per thread, in P2G's
  * chunks, each thread scattering into its own copy of fb.  The scatter's form FB (g2p_point)
  * is chosen outside the loops: one form per loop body keeps the gather's sums in registers
@@ -251,7 +251,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
 #define G2P_SLABS_BY(D, B, FBV, ORD)                                                          \
   do {                                                                                        \
     for (int colour = 0; colour < 2; ++colour) {                                              \
-      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->scr.slab_nt) reduction(min : first_bad) reduction(max : v2m) if (sim->p.n > MPMC_OMP_MIN)") \
       MPMC_SLABS_OF(sim, colour, sl)                                                          \
         MPMC_BATCHES4(B == MPMC_BASIS_LINEAR, D, B, 1, (FBV) != 2, &keep, &sim->grid,         \
                       sim->p.x, sim->p.lp, ORD, start[sl], start[sl + 1], q, l, w4,           \
@@ -259,10 +259,10 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
                           q < first_bad) first_bad = q);                                      \
     }                                                                                         \
   } while (0)
-/* the slab order, or index order where that is the same sequence (sim->order_ident) */
+/* the slab order, or index order where that is the same sequence (sim->scr.order_ident) */
 #define G2P_SLABS(D, B, FBV)                                                                  \
   do {                                                                                        \
-    if (sim->order_ident)                                                                     \
+    if (sim->scr.order_ident)                                                                 \
       G2P_SLABS_BY(D, B, FBV, (const int *)NULL);                                             \
     else                                                                                      \
       G2P_SLABS_BY(D, B, FBV, order);                                                         \
@@ -284,10 +284,10 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
   }                                                                                           \
   static void g2pfb_##D##_##B(mpmc_sim sim, double dt, const g2p_ctx *c, double *fbp, int nc, \
                               int *bad, double *vm) {                                         \
-    const int *restrict order = sim->order, *restrict start = sim->slab_start;                \
-    const int stable = sim->fbar == MPMC_FBAR_STABLE, anc = sim->fbar == MPMC_FBAR_ANCHORED;  \
-    const mpmc_keep keep = mpmc_keep_of(&sim->p);                                             \
-    double *fb0 = stable ? sim->grid.fb : sim->grid.fbj;                                      \
+    const int *restrict order = sim->scr.order, *restrict start = sim->scr.slab_start;        \
+    const int stable = sim->cfg.fbar == MPMC_FBAR_STABLE, anc = sim->cfg.fbar == MPMC_FBAR_ANCHORED; \
+    const mpmc_keep keep = mpmc_keep_of(&sim->fb, D);                                         \
+    double *fb0 = stable ? sim->fb.fb : sim->fb.fbj;                                          \
     int first_bad = INT_MAX;                                                                  \
     double v2m = 0.0;                                                                         \
     if (fbp) { /* P2G's chunks, each scattering into its own copy (p2g.c) */                  \
@@ -299,7 +299,7 @@ MPMC_ALWAYS_INLINE int g2p_point(mpmc_sim sim, const int DIM, const int BASIS, c
         G2P_CHUNKS(D, B, 1);                                                                  \
     } else if (stable) {                                                                      \
       G2P_SLABS(D, B, 2);                                                                     \
-    } else if (sim->slab_axis != 0) { /* rows along x lie within a slab: fb_scatter's WIDE */ \
+    } else if (sim->scr.slab_axis != 0) { /* rows along x lie within a slab: fb_scatter's WIDE */ \
       if (anc)                                                                                \
         G2P_SLABS(D, B, 7);                                                                   \
       else                                                                                    \
@@ -316,7 +316,7 @@ MPMC_KERNELS(G2P_KERNEL)
 
 static int report(mpmc_sim sim, int q) {
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const double *x = p->x + (size_t)q * d; /* where it went */
   const double *dF = p->dF + (size_t)q * d * d;
   const double dJ = d == 2 ? mpmc_det_dim(2, dF) : mpmc_det_dim(3, dF);
@@ -336,27 +336,27 @@ static int report(mpmc_sim sim, int q) {
 /** Phase 3 of the step. */
 int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   const mpmc_grid *g = &sim->grid;
-  g2p_ctx c = {.eta = sim->flip, .travel_scale = dt * g->inv_h,
-               .xold = sim->fbar == MPMC_FBAR_STABLE ? sim->p.xn : NULL};
-  for (int a = 0; a < sim->dim; ++a) {
+  g2p_ctx c = {.eta = sim->cfg.flip, .travel_scale = dt * g->inv_h,
+               .xold = sim->cfg.fbar == MPMC_FBAR_STABLE ? sim->fb.xn : NULL};
+  for (int a = 0; a < sim->cfg.dim; ++a) {
     c.xmin[a] = g->lo[a] - g->h;
     c.xmax[a] = g->hi[a] + g->h;
   }
   int bad = -1;
   double v2max = 0.0;
-  if (sim->fbar && g->fbj) { /* fb and fbj are zero (mpmc_grid_clear_active) */
-    mpmc_grid *gw = &sim->grid;
-    const int nc = gw->nprivate, width = sim->fbar == MPMC_FBAR_STABLE ? 2 : 1;
-    double *fbp = nc ? mpmc_grid_copies(gw, &gw->fbpriv, &gw->cap_fbpriv, width, nc - 1) : NULL;
+  mpmc_fbar_state *f = &sim->fb;
+  if (sim->cfg.fbar && f->fbj) { /* fb and fbj are zero (the step's mpmc_fbar_clear) */
+    const int nc = g->nprivate, width = sim->cfg.fbar == MPMC_FBAR_STABLE ? 2 : 1;
+    double *fbp = nc ? mpmc_grid_copies(g, &f->priv, &f->cap_priv, width, nc - 1) : NULL;
     MPMC_KERNEL_CALL(g2pfb_, sim, sim, dt, &c, fbp, nc, &bad, &v2max);
-    if (fbp) mpmc_grid_add_copies(gw, width == 2 ? gw->fb : gw->fbj, fbp, width, nc - 1);
-    gw->fb_done = 1;
+    if (fbp) mpmc_grid_add_copies(g, width == 2 ? f->fb : f->fbj, fbp, width, nc - 1);
+    f->scattered = 1;
   } else {
     MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad, &v2max);
   }
   /* the stability limit's max |v|^2 (stability.c), unless v is on loan to a caller */
-  sim->v2max = v2max;
-  sim->v2max_ok = bad < 0 && !sim->v_borrowed;
+  sim->scr.v2max = v2max;
+  sim->scr.v2max_ok = bad < 0 && !sim->v_borrowed;
   if (bad >= 0) return report(sim, bad);
   return MPMC_SUCCESS;
 }

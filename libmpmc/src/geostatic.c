@@ -49,17 +49,17 @@ static int by_double(const void *a, const void *b) {
 int mpmc_sim_set_geostatic_stress(mpmc_sim sim, double k0) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
-  const int d = sim->dim, v = d - 1;
+  const int d = sim->cfg.dim, v = d - 1;
   MPMC_CHECK(isfinite(k0) && k0 > 0, ctx, MPMC_ERR_ARG,
              "geostatic stress: K0 = %g must be > 0", k0);
-  const double g = -sim->gravity[v];
+  const double g = -sim->cfg.gravity[v];
   for (int a = 0; a < v; ++a)
-    MPMC_CHECK(sim->gravity[a] == 0.0, ctx, MPMC_ERR_ARG,
+    MPMC_CHECK(sim->cfg.gravity[a] == 0.0, ctx, MPMC_ERR_ARG,
                "geostatic stress: gravity must point along -%c (component %d is %g)", "xyz"[v], a,
-               sim->gravity[a]);
+               sim->cfg.gravity[a]);
   MPMC_CHECK(g > 0, ctx, MPMC_ERR_ARG,
              "geostatic stress: gravity along %c is %g: set a downward gravity first", "xyz"[v],
-             sim->gravity[v]);
+             sim->cfg.gravity[v]);
   MPMC_CALL(mpmc_sim_prepare(sim));
   mpmc_particles *p = &sim->p;
   const int n = p->n;

@@ -37,8 +37,8 @@ int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, c
   return MPMC_SUCCESS;
 }
 
-/* Zeroed, 64-byte aligned (a node record is then one cache line). */
-static int alloc_d(mpmc_context ctx, double **a, size_t n) {
+/* Zeroed, 64-byte aligned (a node record is then one cache line); nothing if *a is set. */
+int mpmc_grid_array(mpmc_context ctx, double **a, size_t n) {
   if (*a) return MPMC_SUCCESS;
   const size_t bytes = (n * sizeof(double) + 63) / 64 * 64;
   void *m = NULL;
@@ -68,17 +68,15 @@ static void set_active_all(mpmc_grid *g) {
   mpmc_grid_rows_full(g);
 }
 
-int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
+int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g) {
   const size_t nn = g->nn;
-  MPMC_CALL(alloc_d(ctx, &g->node, nn * MPMC_NREC));
+  MPMC_CALL(mpmc_grid_array(ctx, &g->node, nn * MPMC_NREC));
   if (!g->rowx) {
     g->rowx = malloc(sizeof(int) * 2 * (size_t)g->n[1] * (size_t)g->n[2]);
     MPMC_CHECK(g->rowx, ctx, MPMC_ERR_MEMORY, "cannot allocate the ranges of %d grid rows",
                g->n[1] * g->n[2]);
     mpmc_grid_rows_full(g); /* a box set before (mpmc_grid_clear) gets its rows */
   }
-  if (with_fbar == MPMC_FBAR_STABLE) MPMC_CALL(alloc_d(ctx, &g->fb, nn * 2));
-  if (with_fbar) MPMC_CALL(alloc_d(ctx, &g->fbj, nn + 4)); /* the gather reads 4 from a row start */
   if (!g->fixed) {
     g->fixed = calloc(nn, sizeof *g->fixed);
     MPMC_CHECK(g->fixed, ctx, MPMC_ERR_MEMORY, "cannot allocate %zu grid flags", nn);
@@ -86,60 +84,39 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar) {
   return MPMC_SUCCESS;
 }
 
-void mpmc_grid_clear(mpmc_grid *g, int with_fbar) {
+void mpmc_grid_clear(mpmc_grid *g) {
   memset(g->node, 0, g->nn * MPMC_NREC * sizeof(double));
-  if (with_fbar && g->fb) memset(g->fb, 0, g->nn * 2 * sizeof(double));
-  if (with_fbar && g->fbj) memset(g->fbj, 0, g->nn * sizeof(double));
   /* conservative: callers that clear by hand may then scatter anywhere */
   set_active_all(g);
-  g->fb_done = 0;
 }
 
-/* Zero the active box's rows of node (when with_node, else only its MPMC_VSLOT), of fb and
- * of fbj (when allocated), on all threads: a serial memset of the landslide's box, ~12 MB, was
- * half of the step's slab phase on two threads. */
-static void clear_box(mpmc_grid *g, int with_node) {
+/* Zero the active box's rows of node on all threads: a serial memset of the landslide's box,
+ * ~12 MB, was half of the step's slab phase on two threads. */
+void mpmc_grid_clear_active(mpmc_grid *g) {
   const long nrow = mpmc_grid_active_rows(g);
   const long box = (long)(g->act_hi[0] - g->act_lo[0]);
-  double *node = g->node, *fb = g->fb, *fbj = g->fbj;
+  double *node = g->node;
 #pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
   for (long r = 0; r < nrow; ++r) {
     size_t len;
     const size_t first = mpmc_grid_active_row(g, r, &len);
-    if (with_node)
-      memset(node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
-    else
-      for (size_t i = first; i < first + len; ++i) node[i * MPMC_NREC + MPMC_VSLOT] = 0.0;
-    if (fb) memset(fb + first * 2, 0, len * 2 * sizeof(double));
-    if (fbj) memset(fbj + first, 0, len * sizeof(double));
+    memset(node + first * MPMC_NREC, 0, len * MPMC_NREC * sizeof(double));
   }
 }
-
-/* the F-bar sums too, whenever allocated (F-bar may have been on in an earlier step); every
- * form's supports lie in the active box */
-void mpmc_grid_clear_active(mpmc_grid *g) {
-  clear_box(g, 1);
-  g->fb_done = 0;
-}
-
-void mpmc_grid_clear_fb_active(mpmc_grid *g) { clear_box(g, 0); }
 
 void mpmc_grid_free(mpmc_grid *g) {
   free(g->node);
   free(g->priv);
-  free(g->fb);
-  free(g->fbj);
   free(g->fixed);
   free(g->ccount);
-  free(g->fbpriv);
   free(g->rowx);
   free(g->rscratch);
   g->rowx = g->rscratch = NULL;
   g->cap_rscratch = 0;
-  g->node = g->fb = g->fbj = g->priv = g->fbpriv = NULL;
+  g->node = g->priv = NULL;
   g->fixed = NULL;
   g->ccount = NULL;
-  g->cap_ccount = g->cap_priv = g->cap_fbpriv = 0;
+  g->cap_ccount = g->cap_priv = 0;
   g->nprivate = 0;
 }
 

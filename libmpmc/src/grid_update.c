@@ -7,8 +7,8 @@
 static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   mpmc_grid *g = &sim->grid;
   const int R = MPMC_NREC, F = MPMC_FOFF;
-  const double alpha = sim->damping;
-  const double *gr = sim->gravity;
+  const double alpha = sim->cfg.damping;
+  const double *gr = sim->cfg.gravity;
   double *restrict rec = g->node;
   const unsigned short *restrict fx = g->fixed;
   /* only the active box holds mass */
@@ -16,12 +16,12 @@ static inline void update_impl(mpmc_sim sim, const int DIM, double dt) {
   const long box = (long)(g->act_hi[0] - g->act_lo[0]);
   /* adaptive damping (damping.c): c from the last step; each node's force against its
    * force of the last step, if it held mass then, into this row's sums */
-  const int adr = sim->adr;
+  const int adr = sim->cfg.adr;
   const double cdt = sim->adr_c * dt < 2.0 ? sim->adr_c * dt : 2.0; /* (2 - c dt) >= 0 */
   const double stamp = (double)sim->stats.steps;
   const double ca = (2.0 - cdt) / (2.0 + cdt), cb = 2.0 * dt / (2.0 + cdt);
   double *restrict fprev = sim->adr_f;
-  double *restrict rowsum = sim->adr_rows;
+  double *restrict rowsum = sim->scr.adr_rows;
   const int oax = adr ? sim->adr_own[0] : -1; /* MPI: the nodes this rank sums (damping.c) */
   const long olo = sim->adr_own[1], ohi = sim->adr_own[2];
 #pragma omp parallel for schedule(static) if (nrow * box > MPMC_OMP_MIN)
@@ -113,8 +113,8 @@ static void rows_empty(mpmc_grid *g, int a, int from, int to) {
 static void grow_box_for_mirrors(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   const size_t n1 = (size_t)g->n[1];
-  for (int w = 0; w < sim->nmirror; ++w) {
-    const mpmc_mirror *m = &sim->mirrors[w];
+  for (int w = 0; w < sim->scr.nmirror; ++w) {
+    const mpmc_mirror *m = &sim->scr.mirrors[w];
     const int a = m->axis;
     if (g->act_hi[a] <= g->act_lo[a]) continue;
     for (int k = 1; k <= MPMC_GHOST; ++k) {
@@ -151,12 +151,12 @@ static void grow_box_for_mirrors(mpmc_sim sim) {
  * partner's reflected velocity and increment (fold = 0). */
 static void mirror_ghosts(mpmc_sim sim, int fold) {
   mpmc_grid *g = &sim->grid;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const size_t R = MPMC_NREC, F = MPMC_FOFF;
   double *rec = g->node;
   const size_t stride[3] = {1, (size_t)g->n[0], (size_t)g->n[0] * (size_t)g->n[1]};
-  for (int w = 0; w < sim->nmirror; ++w) {
-    const mpmc_mirror *m = &sim->mirrors[w];
+  for (int w = 0; w < sim->scr.nmirror; ++w) {
+    const mpmc_mirror *m = &sim->scr.mirrors[w];
     const int a = m->axis, b = (a + 1) % d, c = (a + 2) % d;
     for (int k = 1; k <= MPMC_GHOST; ++k) {
       const int ig = m->plane + m->side * k, im = m->plane - m->side * k;
@@ -174,7 +174,7 @@ static void mirror_ghosts(mpmc_sim sim, int fold) {
               rm[1 + e] += sg * rg[1 + e];
               /* gravity enters the update as (folded mass) * g; the ghost's share of the
                * body force belongs to the partner with the reflection's sign */
-              rm[F + e] += sg * rg[F + e] + (sg - 1.0) * rg[0] * sim->gravity[e];
+              rm[F + e] += sg * rg[F + e] + (sg - 1.0) * rg[0] * sim->cfg.gravity[e];
             }
             rm[0] += rg[0];
           } else {
@@ -191,18 +191,18 @@ static void mirror_ghosts(mpmc_sim sim, int fold) {
 
 /** Phase 2 of the step. */
 int MPMC_ISA(mpmc_grid_update)(mpmc_sim sim, double dt) {
-  if (sim->walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim));
-  if (sim->nmirror) {
+  if (sim->scr.walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim));
+  if (sim->scr.nmirror) {
     grow_box_for_mirrors(sim);
     mirror_ghosts(sim, 1);
   }
   const long nrow = mpmc_grid_active_rows(&sim->grid);
-  if (sim->adr) MPMC_CALL(mpmc_adaptive_damping_prepare(sim, nrow));
-  if (sim->dim == 2)
+  if (sim->cfg.adr) MPMC_CALL(mpmc_adaptive_damping_prepare(sim, nrow));
+  if (sim->cfg.dim == 2)
     update_impl(sim, 2, dt);
   else
     update_impl(sim, 3, dt);
-  if (sim->adr) mpmc_adaptive_damping_finish(sim, nrow);
-  if (sim->nmirror) mirror_ghosts(sim, 0);
+  if (sim->cfg.adr) mpmc_adaptive_damping_finish(sim, nrow);
+  if (sim->scr.nmirror) mirror_ghosts(sim, 0);
   return MPMC_SUCCESS;
 }

@@ -198,7 +198,7 @@ int mpmc_output_create(mpmc_sim sim, const char *h5path, const char *xdmfpath, m
   herr_t st = f < 0 ? -1 : 0;
   if (f >= 0) {
     if (mpmc_h5_attr_write_string(f, "format", "libmpmc-output") < 0) st = -1;
-    if (mpmc_h5_attr_write(f, "dim", H5T_NATIVE_INT, 1, &sim->dim) < 0) st = -1;
+    if (mpmc_h5_attr_write(f, "dim", H5T_NATIVE_INT, 1, &sim->cfg.dim) < 0) st = -1;
     if (H5Fclose(f) < 0) st = -1;
   }
   mpmc_h5_quiet_end(&q);
@@ -264,7 +264,7 @@ static const double *scalar_of(const mpmc_particles *p, int k) {
 /* The records of this rank's points (ids: p->id, or the index when the points have none). */
 static int snap_records(mpmc_sim sim, const snap_layout *L, double **out) {
   const mpmc_particles *p = &sim->p;
-  const int n = p->n, d = sim->dim, w = L->w;
+  const int n = p->n, d = sim->cfg.dim, w = L->w;
   double *rec = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1) * (size_t)w);
   MPMC_CHECK(rec, sim->ctx, MPMC_ERR_MEMORY, "output: cannot allocate a buffer for %d points", n);
   for (size_t q = 0; q < (size_t)n; ++q) {
@@ -418,7 +418,7 @@ int mpmc_output_write(mpmc_output out) {
   /* allocate the fields the scene will have from its first step on, so that every snapshot
    * lists the same fields */
   int err = mpmc_sim_prepare(sim);
-  if (!err && sim->sort_every > 0) { /* the ids, which the first sort would create */
+  if (!err && sim->cfg.sort_every > 0) { /* the ids, which the first sort would create */
     const int *ids;
     err = mpmc_sim_get_particle_ids(sim, &ids);
   }

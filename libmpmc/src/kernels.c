@@ -54,7 +54,7 @@ static int use_kernels(mpmc_sim s, int request, const char *what) {
   const int ok = request == MPMC_KERNELS_AUTO || request == MPMC_KERNELS_BASELINE ||
                  (request == MPMC_KERNELS_AVX512 ? avx512 : avx2);
   MPMC_CHECK(ok, s->ctx, MPMC_ERR_ARG, "%s: %s", what, kernels_missing(request));
-  s->kernels = request != MPMC_KERNELS_AUTO ? request
+  s->cfg.kernels = request != MPMC_KERNELS_AUTO ? request
                : avx512                     ? MPMC_KERNELS_AVX512
                : avx2                       ? MPMC_KERNELS_FMA
                                             : MPMC_KERNELS_BASELINE;
@@ -112,7 +112,7 @@ int mpmc_sim_set_kernels(mpmc_sim sim, int kernels) {
 int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(kernels, sim->ctx, MPMC_ERR_ARG, "kernels pointer is NULL");
-  *kernels = sim->kernels;
+  *kernels = sim->cfg.kernels;
   return MPMC_SUCCESS;
 }
 
@@ -138,9 +138,9 @@ static const mpmc_kernel_set avx512 = {mpmc_slabs_build_avx512, mpmc_p2g_avx512,
 /** The kernel set the sim's step runs (mpmc_sim_set_kernels). */
 const mpmc_kernel_set *mpmc_kernels_of(const struct mpmc_sim_s *sim) {
 #ifdef MPMC_HAVE_AVX2_KERNELS
-  return sim->kernels == MPMC_KERNELS_AVX512 ? &avx512
-         : sim->kernels == MPMC_KERNELS_FMA  ? &fused
-         : sim->kernels == MPMC_KERNELS_AVX2 ? &avx2
+  return sim->cfg.kernels == MPMC_KERNELS_AVX512 ? &avx512
+         : sim->cfg.kernels == MPMC_KERNELS_FMA  ? &fused
+         : sim->cfg.kernels == MPMC_KERNELS_AVX2 ? &avx2
                                              : &baseline;
 #else
   (void)sim;

@@ -60,7 +60,7 @@ static int frictional_point(const void *model, mpmc_rm_ws *ws, int solver, doubl
 
 static int frictional_fail(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                            const void *model, mpmc_rm_ws *ws, mpmc_return_point *pt) {
-  const int solver = sim->solver;
+  const int solver = sim->cfg.solver;
   double tau[6], Je;
   mpmc_mc_info info = {0};
   const int err = mpmc_mc_update(ws, solver, model, pt->F, pt->be, &pt->eps_p, tau, &Je, &info);

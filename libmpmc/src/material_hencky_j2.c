@@ -153,7 +153,7 @@ int mpmc_j2_return_map(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, doubl
 static int j2_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) {
   (void)dt;
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim, solver = sim->solver;
+  const int d = sim->cfg.dim, solver = sim->cfg.solver;
   const mpmc_j2_param par = {mat->K, mat->G, mat->kappa_p, mat->kappa_r, mat->eta};
   const int nthreads = mpmc_max_threads();
   mpmc_rm_ws **ws;

@@ -115,7 +115,7 @@ int mpmc_material_add(struct mpmc_sim_s *sim, const mpmc_model *md, const double
   sim->mats[sim->nmat] = m;
   if (id) *id = sim->nmat;
   sim->nmat++;
-  sim->prepared = 0;
+  sim->scr.prepared = 0;
   return MPMC_SUCCESS;
 }
 

@@ -96,7 +96,7 @@ int mpmc_sim_get_user_state(mpmc_sim sim, int material, double **state, int *nst
 
 static int user_update(mpmc_sim sim, const mpmc_material *mat, int id, double dt) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const size_t ns = (size_t)p->nustate;
   const mpmc_user_stress_fn fn = mat->user_fn;
   void *data = mat->user_data;

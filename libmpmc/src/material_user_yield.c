@@ -29,7 +29,7 @@ static int uy_fail(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, con
                    mpmc_rm_ws *ws, mpmc_return_point *pt) {
   const mpmc_particles *p = &sim->p;
   const mpmc_cpp_param *cp = model;
-  const int q = pt->q, solver = sim->solver;
+  const int q = pt->q, solver = sim->cfg.solver;
   double tau[6], Je;
   mpmc_cpp_info info = {0};
   int err = mpmc_cpp_return_map(ws, solver, cp, pt->F, pt->be, &pt->eps_p, tau, &Je, &info);

@@ -34,7 +34,7 @@
 
 /* The inputs that may add energy.  Loads also enter through sum |f| (check passes only). */
 static void signature(const mpmc_sim sim, double *sig) {
-  for (int a = 0; a < 3; ++a) sig[a] = sim->gravity[a];
+  for (int a = 0; a < 3; ++a) sig[a] = sim->cfg.gravity[a];
   double k = sim->nmat;
   for (int m = 0; m < sim->nmat; ++m) k += sim->mats[m].srm; /* strength reductions */
   sig[3] = k;
@@ -68,8 +68,8 @@ typedef struct {
 static sums pass(const mpmc_sim sim, int with_psi) {
   const mpmc_particles *p = &sim->p;
   const mpmc_material *mats = sim->mats;
-  const double *g = sim->gravity, *f = p->force;
-  const int d = sim->dim;
+  const double *g = sim->cfg.gravity, *f = p->force;
+  const int d = sim->cfg.dim;
   double ke = 0.0, v2max = 0.0, gx = 0.0, fx = 0.0, fa = 0.0, psi = 0.0;
   int bad = INT_MAX;
 #pragma omp parallel for reduction(+ : ke, gx, fx, fa, psi) reduction(max : v2max) \
@@ -123,7 +123,7 @@ static void baseline(mpmc_monitor *mo, const sums *s, int64_t step, const double
 int mpmc_monitor_step(mpmc_sim sim) {
   mpmc_monitor *mo = &sim->monitor;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const int64_t step = sim->stats.steps + 1; /* this step, counted from 1 */
   int energy = mo->factor >= 0.0 && !sim->bodies;
   for (int m = 0; m < sim->nmat && energy; ++m) energy = !(sim->mats[m].model->flags & MPMC_MODEL_CALLBACK);
@@ -165,7 +165,7 @@ int mpmc_monitor_step(mpmc_sim sim) {
   mo->ke_last = s.ke;
   if (!(s.ke > lim)) return MPMC_SUCCESS;
   double jr[2] = {-INFINITY, -INFINITY}; /* -min J, max J for the hint below */
-  if (sim->fbar == MPMC_FBAR_TOTAL || sim->fbar == MPMC_FBAR_STABLE) {
+  if (sim->cfg.fbar == MPMC_FBAR_TOTAL || sim->cfg.fbar == MPMC_FBAR_STABLE) {
     for (int i = 0; i < p->n; ++i) jr[0] = fmax(jr[0], -p->J[i]), jr[1] = fmax(jr[1], p->J[i]);
     mpmc_dd_max(sim, jr, 2); /* MPI: over the ranks */
   }
@@ -184,13 +184,13 @@ int mpmc_monitor_step(mpmc_sim sim) {
   /* The forms that project det F itself follow the points' own J, which drifts in a large
    * flow (splashing, run-up; docs/theory.md): say so, with the range of J. */
   char hint[256] = "";
-  if (sim->fbar == MPMC_FBAR_TOTAL || sim->fbar == MPMC_FBAR_STABLE) {
+  if (sim->cfg.fbar == MPMC_FBAR_TOTAL || sim->cfg.fbar == MPMC_FBAR_STABLE) {
     const double jmin = -jr[0], jmax = jr[1];
     snprintf(hint, sizeof hint,
              "; or, in a large flow, use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene "
              "'fbar: true'): the %s form projects the points' own J, which drift in a flow "
              "(here %.3g to %.3g)",
-             sim->fbar == MPMC_FBAR_TOTAL ? "total" : "stable", jmin, jmax);
+             sim->cfg.fbar == MPMC_FBAR_TOTAL ? "total" : "stable", jmin, jmax);
   }
   return MPMC_ERROR(sim->ctx, MPMC_ERR_UNSTABLE,
                     "step %lld, t = %g: kinetic energy grows without input: E_k = %.4g J exceeds "

@@ -194,8 +194,8 @@ int mpmc_dd_setup(struct mpmc_sim_s *sim) {
   struct mpmc_dd_s *dd = sim->dd;
   if (!dd) return MPMC_SUCCESS;
   const mpmc_grid *g = &sim->grid;
-  int ax = sim->dim - 1;
-  for (int a = sim->dim - 2; a >= 0; --a)
+  int ax = sim->cfg.dim - 1;
+  for (int a = sim->cfg.dim - 2; a >= 0; --a)
     if (g->n[a] > g->n[ax]) ax = a;
   const int cells = g->n[ax] - 1;
   MPMC_CHECK(cells >= MPMC_DD_MIN_CELLS * dd->size, sim->ctx, MPMC_ERR_ARG,
@@ -433,8 +433,8 @@ static void unpack_add(mpmc_grid *g, double *arr, int width, const double *in) {
  * not reach a halo, whose nodes only the halo sums complete. */
 static int check_mirrors(struct mpmc_sim_s *sim) {
   const struct mpmc_dd_s *dd = sim->dd;
-  for (int w = 0; w < sim->nmirror; ++w) {
-    const mpmc_mirror *m = &sim->mirrors[w];
+  for (int w = 0; w < sim->scr.nmirror; ++w) {
+    const mpmc_mirror *m = &sim->scr.mirrors[w];
     if (m->axis != dd->axis) continue;
     for (int r = 1; r < dd->size; ++r) {
       const int b = dd->cut[r];
@@ -458,15 +458,15 @@ int mpmc_dd_halo(struct mpmc_sim_s *sim, int what) {
   double *arr;
   int width;
   if (what == MPMC_DD_NODES) {
-    if (sim->walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim)); /* the mirrors */
+    if (sim->scr.walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim)); /* the mirrors */
     MPMC_CALL(check_mirrors(sim));
     arr = g->node;
     width = MPMC_NREC;
-  } else if (sim->fbar == MPMC_FBAR_STABLE) {
-    arr = g->fb;
+  } else if (sim->cfg.fbar == MPMC_FBAR_STABLE) {
+    arr = sim->fb.fb;
     width = 2;
   } else {
-    arr = g->fbj;
+    arr = sim->fb.fbj;
     width = 1;
   }
   const int ax = dd->axis;
@@ -508,7 +508,7 @@ typedef struct {
 
 static int fields_of(struct mpmc_sim_s *sim, field *f) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   int k = 0;
   f[k++] = (field){&p->x, d, 0.0};
   f[k++] = (field){&p->x0, d, 0.0};
@@ -655,18 +655,18 @@ static int migrate(struct mpmc_sim_s *sim, int far) {
       *rd = rc + P;
   int nout = 0;
   for (int q = 0; q < n && !err; ++q) {
-    const int c = slab_cell(sim, p->x + (size_t)q * sim->dim);
+    const int c = slab_cell(sim, p->x + (size_t)q * sim->cfg.dim);
     const int r = c < dd->cut[me] || c >= dd->cut[me + 1] ? rank_of_cell(dd, c) : me;
     dest[q] = r;
     if (!far && (r < me - 1 || r > me + 1)) {
       char nb[MPMC_POINT_NAME_LEN];
-      const double *x = p->x + (size_t)q * sim->dim;
+      const double *x = p->x + (size_t)q * sim->cfg.dim;
       err = MPMC_ERROR(ctx, MPMC_ERR_UNSTABLE,
                        "step %lld, t = %g: point %s at (%g, %g, %g) moved from rank %d's slab "
                        "(cells %d .. %d along axis %d) to rank %d's in one step, across more "
                        "than one subdomain: reduce the time step or use fewer ranks",
                        (long long)sim->stats.steps, sim->time, mpmc_point_name(p, q, nb), x[0],
-                       x[1], sim->dim == 3 ? x[2] : 0.0, me, dd->cut[me], dd->cut[me + 1] - 1,
+                       x[1], sim->cfg.dim == 3 ? x[2] : 0.0, me, dd->cut[me], dd->cut[me + 1] - 1,
                        dd->axis, r);
     } else if (r != me) {
       hs[(size_t)r * HDR]++;
@@ -825,8 +825,8 @@ static int migrate(struct mpmc_sim_s *sim, int far) {
   free(member);
   free(sb);
   if (nin > 0 || nout) {
-    sim->order_ident = 0;
-    sim->v2max_ok = 0; /* the stability limit takes its pass over v (stability.c) */
+    sim->scr.order_ident = 0;
+    sim->scr.v2max_ok = 0; /* the stability limit takes its pass over v (stability.c) */
   }
   return mpmc_dd_agree(sim, err);
 }
@@ -877,10 +877,10 @@ int mpmc_sim_get_mpi_imbalance(const mpmc_sim sim, double *value, long *balances
  * -1 if there is none. */
 static int clear_of_mirrors(const struct mpmc_sim_s *sim, int c, int lo, int hi) {
   const int reach = MPMC_GHOST + 1;
-  for (int pass = 0; pass <= sim->nmirror; ++pass) {
+  for (int pass = 0; pass <= sim->scr.nmirror; ++pass) {
     int moved = 0;
-    for (int w = 0; w < sim->nmirror; ++w) {
-      const mpmc_mirror *m = &sim->mirrors[w];
+    for (int w = 0; w < sim->scr.nmirror; ++w) {
+      const mpmc_mirror *m = &sim->scr.mirrors[w];
       if (m->axis != sim->dd->axis || c < m->plane - reach || c > m->plane + reach) continue;
       const int below = m->plane - reach - 1, above = m->plane + reach + 1;
       const int okb = below >= lo && below <= hi, oka = above >= lo && above <= hi;
@@ -898,7 +898,7 @@ static int clear_of_mirrors(const struct mpmc_sim_s *sim, int c, int lo, int hi)
 static int balance(struct mpmc_sim_s *sim) {
   struct mpmc_dd_s *dd = sim->dd;
   const int P = dd->size, cells = dd->cut[P];
-  if (sim->walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim)); /* the mirrors */
+  if (sim->scr.walls_dirty) MPMC_CALL(mpmc_boundary_apply_flags(sim)); /* the mirrors */
   long long *cum = calloc((size_t)cells + 1, sizeof *cum);
   int *nc = malloc(sizeof(int) * (size_t)(P + 1));
   int err = cum && nc ? MPMC_SUCCESS : MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "balance: no memory");
@@ -908,7 +908,7 @@ static int balance(struct mpmc_sim_s *sim) {
     free(nc);
     return err;
   }
-  for (int q = 0; q < sim->p.n; ++q) cum[1 + slab_cell(sim, sim->p.x + (size_t)q * sim->dim)]++;
+  for (int q = 0; q < sim->p.n; ++q) cum[1 + slab_cell(sim, sim->p.x + (size_t)q * sim->cfg.dim)]++;
   MPI_Allreduce(MPI_IN_PLACE, cum + 1, cells, MPI_LONG_LONG, MPI_SUM, dd->comm);
   for (int c = 1; c <= cells; ++c) cum[c] += cum[c - 1]; /* cum[c]: points in cells < c */
   nc[0] = 0;

@@ -6,7 +6,8 @@ int mpmc_bench_grid(mpmc_sim sim, int lo[3], int hi[3], size_t *record_bytes, si
   if (!sim) return MPMC_ERR_ARG;
   const mpmc_grid *g = &sim->grid;
   for (int a = 0; a < 3; ++a) lo[a] = g->act_lo[a], hi[a] = g->act_hi[a];
-  *record_bytes = sizeof(double) * MPMC_NREC + (g->fb ? 2 * sizeof(double) : g->fbj ? sizeof(double) : 0);
+  const mpmc_fbar_state *f = &sim->fb;
+  *record_bytes = sizeof(double) * MPMC_NREC + (f->fb ? 2 * sizeof(double) : f->fbj ? sizeof(double) : 0);
   *node_bytes = *record_bytes + sizeof *g->fixed;
   return MPMC_SUCCESS;
 }
@@ -19,7 +20,7 @@ void mpmc_bench_layout(int *ghost_cells, int *min_slab_cells) {
 double mpmc_bench_bytes_per_point(mpmc_sim sim) {
   if (!sim) return 0.0;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const struct {
     const void *a;
     int n;
@@ -27,10 +28,10 @@ double mpmc_bench_bytes_per_point(mpmc_sim sim) {
            {p->J, 1},      {p->stress, 6}, {p->Jbar, 1},       {p->Janc, 1},   {p->be, 6},
            {p->eps_p, 1},  {p->region, 1}, {p->Jp, 1},         {p->pw, 1},     {p->lp, 1},
            {p->force, d},  {p->cforce, d}, {p->ustate, p->nustate},            {p->dF, d * d},
-           {p->xn, d},     {p->xoff, d}};
+           {sim->fb.xn, d}, {sim->fb.xoff, d}};
   double b = sizeof(int) * (p->id ? 3.0 : 2.0); /* material id, slab order, point id (sort) */
-  if (p->xnode) b += sizeof(int);               /* F-bar's kept first nodes (transfer.h) */
-  if (sim->fb_scale) b += sizeof(double);       /* F-bar's deferred factors (stress_j2.c) */
+  if (sim->fb.xnode) b += sizeof(int);          /* F-bar's kept first nodes (transfer.h) */
+  if (sim->fb.scale) b += sizeof(double);       /* F-bar's deferred factors (stress_j2.c) */
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i)
     if (f[i].a) b += sizeof(double) * (double)f[i].n;
   return b;

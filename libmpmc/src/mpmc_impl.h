@@ -84,12 +84,6 @@ typedef struct {
   int global_ids; /* over MPI: ids are indices among every rank's points (always named)  */
   /* step scratch */
   double *dF;    /* [n][dim*dim] relative deformation gradient, row-major         */
-  double *xn;    /* [n][dim] with F-bar's stable form x^n, from G2P (which moves x) to the
-                    gather                                                          */
-  double *xoff;  /* [dim][cap] with F-bar's paper, total and anchored forms, from G2P to the gather:
-                    the points' offsets at x^n from their first stencil nodes (axis a's
-                    at xoff + a cap), from which the basis gives their weights          */
-  int *xnode;    /* [n] those first stencil nodes (transfer.h, mpmc_kept_weights4)   */
 } mpmc_particles;
 
 /* A point's name in error messages: its index, and its id (the index it was added with)
@@ -131,13 +125,6 @@ typedef struct {
   double *node;        /* [nn][MPMC_NREC] mass, momentum, f_int + f_ext (slots above), with
                           F-bar's paper, total and anchored forms sum w V^n in MPMC_VSLOT; after the
                           grid update mass, new velocity, velocity increment            */
-  double *fb;          /* [nn][2] F-bar's stable form only: sum w V, sum w V J in its own
-                          space                                                           */
-  double *fbj;         /* [nn + 4] F-bar: the nodal Jbar in the active box (fbar.c); in the
-                          paper, total and anchored forms G2P scatters sum w V^n j here first, which
-                          the normalisation divides by MPMC_VSLOT's sum in place; the
-                          gather loads rows of four from a row's first node, the lanes
-                          beyond the stencil unused                                      */
   unsigned short *fixed; /* [nn] bit a: component a fixed; bit 3+a: v_a >= 0 only; bit 6+a: v_a <= 0 only */
   /* node index box [act_lo, act_hi) per axis outside which node and fb are zero: the points'
    * stencils of the last P2G (and the mirror partners the grid update folded into); the
@@ -154,35 +141,29 @@ typedef struct {
   int *rscratch; /* p2g.c scratch: per chunk, the x range of the cells of each cell row */
   size_t cap_rscratch;
   int rows_skip; /* slab builds left that take the whole box's rows (p2g.c, row_ranges) */
-  int fb_done;         /* G2P scattered this step's F-bar volumes (fused, race-free)     */
-  int fb_gather;       /* the step's F-bar gather is left to the material update (every
-                          material's ops->gathers_fbar): it takes x^n as G2P kept it
-                          (the points' xoff and xnode, or xn; fbar.c)                   */
   int *ccount;         /* p2g.c scratch: points per plane of cells, slab fill positions   */
   size_t cap_ccount;
   /* per-thread accumulation (p2g.c, private_grids) when slabs cannot keep the threads busy:
-   * the other threads' copies of node and fb, zero outside the active box; nprivate: this
-   * step's P2G ran that way on nprivate threads (G2P's F-bar scatter follows it) */
-  double *priv, *fbpriv;
-  size_t cap_priv, cap_fbpriv;
+   * the other threads' copies of node, zero outside the active box; nprivate: this step's
+   * P2G ran that way on nprivate threads (G2P's F-bar scatter follows it) */
+  double *priv;
+  size_t cap_priv;
   int nprivate;
   int valid;
 } mpmc_grid;
 
 int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, const double *hi,
                     double h);
-/* with_fbar: the F-bar form (mpmc_fbar_mode; fb for the stable form alone) */
-int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g, int with_fbar);
-/* zero the whole grid (with_fbar: the F-bar sums too) */
-void mpmc_grid_clear(mpmc_grid *g, int with_fbar);
+int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g);
+/* *a: n zeroed doubles, 64-byte aligned (unless *a is set already) */
+int mpmc_grid_array(mpmc_context ctx, double **a, size_t n);
+/* zero the whole grid (every node active) */
+void mpmc_grid_clear(mpmc_grid *g);
 /* zero the active box only (the hot path: everything outside it is zero already) */
 void mpmc_grid_clear_active(mpmc_grid *g);
 double *mpmc_grid_copies(const mpmc_grid *g, double **buf, size_t *cap, int width, int ncopies);
 void mpmc_grid_add_copies(const mpmc_grid *g, double *dst, double *copies, int width,
                           int ncopies);
-/* zero the F-bar sums of the active box (the F-bar projection's nodes, in every form): fb,
- * fbj and the records' MPMC_VSLOT */
-void mpmc_grid_clear_fb_active(mpmc_grid *g);
 void mpmc_grid_free(mpmc_grid *g);
 /* every row of the active box over the box's whole x range (grid.rowx) */
 void mpmc_grid_rows_full(mpmc_grid *g);
@@ -214,6 +195,37 @@ static inline double mpmc_grid_mass(const mpmc_grid *g, size_t i) {
   return g->node[i * MPMC_NREC];
 }
 
+/* ---- F-bar's step state (fbar.c owns it; the life of a step is told at the top of fbar.c) */
+/* What the projection keeps between the phases of one step, none of it from one step to the
+ * next: the nodal sums and what G2P keeps of x^n for the gather.  The points' own F-bar
+ * state travels with them in the particle arrays (Jbar, Janc, Jp: sorted, migrated and
+ * checkpointed with the rest) and the nodal volume sum of the paper, total and anchored
+ * forms rides in the node records (MPMC_VSLOT).  Allocated by mpmc_fbar_prepare for the form
+ * in use; what a form does not use stays NULL. */
+typedef struct {
+  size_t nn;      /* grid nodes the sums hold (0: none allocated)                        */
+  double *fb;     /* [nn][2] the stable form only: sum w V, sum w V J in its own space   */
+  double *fbj;    /* [nn + 4] the nodal Jbar in the active box; in the paper, total and
+                     anchored forms G2P scatters sum w V^n j here first, which the
+                     average divides by MPMC_VSLOT's sum in place; the gather loads rows
+                     of four from a row's first node, the lanes beyond the stencil unused */
+  double *priv;   /* G2P's other threads' copies of fb or fbj, when P2G ran on private
+                     grids (g2p.c; grid.nprivate)                                       */
+  size_t cap_priv;
+  int cap;        /* points the kept arrays below hold (at least the particles' n)      */
+  double *xn;     /* [cap][dim] the stable form: x^n, from G2P (which moves x) to the gather */
+  double *xoff;   /* [dim][cap] the paper, total and anchored forms: the points' offsets at
+                     x^n from their first stencil nodes (axis a's at xoff + a cap), from
+                     which the basis gives their weights (transfer.h, mpmc_kept_weights4) */
+  int *xnode;     /* [cap] those first stencil nodes                                     */
+  double *scale;  /* [cap_scale] the deferred gather's factors of dF (stress_j2.c,
+                     stress_blocks.c), allocated by the first deferred gather            */
+  int cap_scale;
+  int scattered;  /* G2P scattered this step's volumes (fused, race-free)                */
+  int deferred;   /* the step's gather is left to the material update (every material's
+                     ops->gathers_fbar): it takes x^n as G2P kept it                     */
+} mpmc_fbar_state;
+
 /* ---- materials: the model table (material_table.c) and one file per model ------------- */
 struct mpmc_sim_s;
 typedef struct mpmc_material_s mpmc_material;
@@ -227,10 +239,10 @@ typedef struct {
   /* p-wave speed for the stable time step */
   double (*wave_speed)(const mpmc_material *mat);
   /* 1: stress_update runs F-bar's gather for its points itself when the step defers it
-   * (grid.fb_gather; fbar.c mpmc_fbar_gather_range), scaling dF as it loads it */
+   * (sim->fb.deferred; fbar.c mpmc_fbar_gather_range), scaling dF as it loads it */
   int gathers_fbar;
   /* 1: stress_update guards its stresses itself: the lowest index of a point it left with a
-   * non-finite stress into sim->stress_bad (stress_update.c) */
+   * non-finite stress into sim->scr.stress_bad (stress_update.c) */
   int checks_stress;
 } mpmc_material_ops;
 
@@ -403,49 +415,38 @@ int mpmc_water_set(struct mpmc_sim_s *sim, int kind, int n, const double *xh,
                    const double *plane, double gamma_w, int masses);
 
 /* ---- the simulation ---------------------------------------------------------------- */
-struct mpmc_sim_s {
-  mpmc_context ctx;
+/* What the caller chose of the method (mpmc_sim_set_*): read by the steps, changed only
+ * between them; checkpointed with the data. */
+typedef struct {
   int dim;
   int basis;
-  int fbar;
+  int fbar;           /* F-bar's form (mpmc_fbar_mode; 0: off)                          */
   double flip;        /* FLIP/PIC blend eta (eq 13)                                    */
   double gravity[3];
   double damping;     /* local damping alpha                                           */
-  mpmc_water_table wt; /* hydrostatic pore pressure below a phreatic line (water.c)    */
   int kdamp;          /* kinetic damping on (damping.c, mpmc_kinetic_damping)           */
-  double kd_ke;       /* kinetic damping: E_k of the points after the last step; -1: none */
-  /* adaptive viscous damping (damping.c): c = 2 zeta omega, omega^2 a Rayleigh quotient of the
-   * grid's force change over the velocity, smoothed as num / den of running sums */
-  int adr;            /* on                                                             */
-  double adr_zeta;    /* damping ratio of the estimated mode: c = 2 zeta omega          */
-  double adr_c;       /* the damping coefficient c [1/s] the next grid update applies   */
-  double adr_sum[2];  /* running sums of v.(f^{n-1} - f^n) and dt m v.v (the quotient)  */
-  double *adr_f;      /* [grid nn][1 + dim]: the step a node last held mass, its force then */
-  size_t adr_nf;      /* doubles in adr_f (0: none)                                     */
-  double *adr_rows;   /* [rows][2] the grid update's per-row sums, added in row order   */
-  size_t adr_nrows;
-  int adr_own[3];     /* over MPI: the slab axis and the node planes [lo, hi) along it whose
-                       * nodes this rank adds to the sums (each halo node once); axis -1: all */
-  int solver;
-  int nthreads;
-  int force_dt;
-  mpmc_grid grid;
-  mpmc_particles p;
-  mpmc_material *mats;
-  int nmat, capmat;
-  int stress_bad; /* the step's stress guard: lowest point with a non-finite stress (INT_MAX) */
-  mpmc_wall *walls;
-  int nwall, capwall;
+  int adr;            /* adaptive viscous damping on (damping.c)                        */
+  double adr_zeta;    /* its damping ratio of the estimated mode: c = 2 zeta omega      */
+  int solver;         /* local return mapping's solver (mpmc_solver)                    */
+  int nthreads;       /* OpenMP threads of a step; 0: the caller's                      */
+  int force_dt;       /* steps above the stability limit allowed                        */
+  int kernels;        /* kernel set in use: MPMC_KERNELS_BASELINE or _AVX2              */
+  int sort_every;     /* sort the points by cell every this many steps; 0: never        */
+} mpmc_settings;
+
+/* What a step rebuilds from the settings and the data, never checkpointed: the slabs of the
+ * race-free scatter, the return maps' workspaces, the grid update's per-row sums, the
+ * stress guard, the speed the stability limit reads, and what is to be rebuilt. */
+typedef struct {
+  int prepared;       /* fields and grid arrays match the configuration (mpmc_sim_prepare) */
   int walls_dirty;    /* recompute the node constraint flags                           */
   mpmc_mirror *mirrors; /* derived from the walls by mpmc_boundary_apply_flags          */
   int nmirror;
-  int prepared;       /* fields and grid arrays match the configuration               */
-  double time;
-  mpmc_stats stats;
+  int stress_bad; /* the step's stress guard: lowest point with a non-finite stress (INT_MAX) */
   void *solver_ws;    /* return-mapping workspaces (return_map.c), per thread          */
-  double *fb_scale;   /* [n] F-bar's factors of dF, the deferred gather's (stress_j2.c);
-                         scratch within a step, allocated by fbar.c when first needed  */
-  int cap_fb_scale;
+  double *adr_rows;   /* [rows][2] adaptive damping: the grid update's per-row sums, added in
+                         row order                                                      */
+  size_t adr_nrows;
   /* race-free scatter (p2g.c): points bucketed into slabs of at least MPMC_SLAB_W cells
    * along one axis; slabs of one colour (parity) never touch the same node, so they run in
    * parallel */
@@ -460,21 +461,50 @@ struct mpmc_sim_s {
    * group[c][t + 1], for t < slab_nt (mpmc_slab_group, MPMC_SLABS_OF) */
   int *slab_group;    /* [2][slab_nt + 1] */
   int slab_nt, cap_group;
-  struct mpmc_bodies_s *bodies; /* rigid bodies and barrier contact (contact_barrier.c) */
-  struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
-  struct mpmc_sets_s *node_sets; /* named grid node sets (sets.c)                     */
-  mpmc_monitor monitor;         /* energy check after each step (monitor.c)           */
-  int kernels;                  /* kernel set in use: MPMC_KERNELS_BASELINE or _AVX2   */
-  int sort_every;               /* sort the points by cell every this many steps; 0: never */
-  int64_t sort_last;            /* step count at the last sort; -1: none yet (sort.c)   */
-  int sort_axis;                /* the slab axis the last sort put outermost; -1: none  */
   /* max_p |v_p|^2 as G2P left v (stability.c reads it instead of a pass over v): valid
    * (v2max_ok) from a G2P while the velocity field is not borrowed (mpmc_sim_get_field,
    * until mpmc_sim_restore_field: both clear it) */
   double v2max;
-  int v2max_ok, v_borrowed;
+  int v2max_ok;
+} mpmc_scratch;
+
+/* A simulation: its settings (cfg), its data (the points, the grid, the materials, walls,
+ * bodies and sets, the water table, the time and the run's counters: what a checkpoint
+ * holds) and the step's scratch (scr, and F-bar's, fb). */
+struct mpmc_sim_s {
+  mpmc_context ctx;
+  mpmc_settings cfg;
+  /* data */
+  mpmc_particles p;
+  mpmc_grid grid;
+  mpmc_material *mats;
+  int nmat, capmat;
+  mpmc_wall *walls;
+  int nwall, capwall;
+  mpmc_water_table wt; /* hydrostatic pore pressure below a phreatic line (water.c)    */
+  struct mpmc_bodies_s *bodies; /* rigid bodies and barrier contact (contact_barrier.c) */
+  struct mpmc_sets_s *sets;     /* named particle sets (sets.c)                       */
+  struct mpmc_sets_s *node_sets; /* named grid node sets (sets.c)                     */
+  double time;
+  mpmc_stats stats;
+  mpmc_monitor monitor;         /* energy check after each step (monitor.c)           */
+  double kd_ke;       /* kinetic damping: E_k of the points after the last step; -1: none */
+  /* adaptive viscous damping (damping.c): c = 2 zeta omega, omega^2 a Rayleigh quotient of the
+   * grid's force change over the velocity, smoothed as num / den of running sums */
+  double adr_c;       /* the damping coefficient c [1/s] the next grid update applies   */
+  double adr_sum[2];  /* running sums of v.(f^{n-1} - f^n) and dt m v.v (the quotient)  */
+  double *adr_f;      /* [grid nn][1 + dim]: the step a node last held mass, its force then */
+  size_t adr_nf;      /* doubles in adr_f (0: none)                                     */
+  int adr_own[3];     /* over MPI: the slab axis and the node planes [lo, hi) along it whose
+                       * nodes this rank adds to the sums (each halo node once); axis -1: all */
+  int64_t sort_last;  /* step count at the last sort; -1: none yet (sort.c)             */
+  int sort_axis;      /* the slab axis the last sort put outermost; -1: none            */
+  int v_borrowed;     /* the velocity field is on loan to the caller (mpmc_sim_get_field) */
   struct mpmc_dd_s *dd; /* the MPI decomposition (mpi.c); NULL: one process            */
   int64_t np_global;    /* points added so far over all ranks (their ids: 0 ..)        */
+  /* scratch */
+  mpmc_scratch scr;
+  mpmc_fbar_state fb; /* F-bar's step state (fbar.c)                                  */
 };
 
 /* Minimum slab width in cells: a point in cell c touches nodes c-1 .. c+2 at most (cubic),
@@ -486,11 +516,11 @@ struct mpmc_sim_s {
 static inline int mpmc_chunk_start(int n, int t, int nc) { return (int)((long long)n * t / nc); }
 /* Thread t's slabs of colour c run from mpmc_slab_group(sim, c, t) (in steps of two) to
  * mpmc_slab_group(sim, c, t + 1) (p2g.c, slab_groups). */
-#define mpmc_slab_group(sim, c, t) ((sim)->slab_group[(c) * ((sim)->slab_nt + 1) + (t)])
+#define mpmc_slab_group(sim, c, t) ((sim)->scr.slab_group[(c) * ((sim)->scr.slab_nt + 1) + (t)])
 /* Loop header: the slabs sl of colour c, each thread its own run of them (slab_groups), in
  * an OpenMP loop whose pragma (with clauses for the body's reductions) precedes it. */
 #define MPMC_SLABS_OF(sim, c, sl)                  \
-  for (int t_ = 0; t_ < (sim)->slab_nt; ++t_)      \
+  for (int t_ = 0; t_ < (sim)->scr.slab_nt; ++t_) \
     for (int sl = mpmc_slab_group(sim, c, t_); sl < mpmc_slab_group(sim, c, t_ + 1); sl += 2)
 /* The slab axis for points whose cells span [clo, chi] per axis: the outermost axis of the
  * grid's memory (z in 3D, y in 2D) when the points span MPMC_SLAB_PLANES cell planes along
@@ -516,7 +546,7 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
  * with MPMC_ISA_AVX2 defined, which appends _avx2 to their external names, with MPMC_ISA_FMA
  * (_fma) and fused multiply-adds allowed, and as fma for x86-64-v4 (AVX-512) with
  * MPMC_ISA_AVX512 (_avx512; MPMC_ISA_FMA defined as well, the source's fma paths being its
- * own).  A sim runs one set (sim->kernels, mpmc_sim_set_kernels); baseline and avx2 give the
+ * own).  A sim runs one set (sim->cfg.kernels, mpmc_sim_set_kernels); baseline and avx2 give the
  * same bits, as ISO C mode allows no floating-point contraction (tests/t303); fma differs
  * from them by round-off; avx512 gives fma's bits with this compiler (t303 checks it): the
  * same operations, contracted alike, in the 32 vector registers of AVX-512's encoding. */
@@ -528,6 +558,7 @@ static inline int mpmc_slab_axis(int dim, const int *clo, const int *chi) {
 #define MPMC_ISA(fn) fn##_avx2
 #else
 #define MPMC_ISA(fn) fn
+#define MPMC_ISA_BASELINE /* the baseline compile: a kernel file's functions that exist once */
 #endif
 #define MPMC_KERNEL_PROTOTYPES(S)                              \
   int mpmc_slabs_build##S(struct mpmc_sim_s *sim);             \
@@ -589,6 +620,20 @@ int mpmc_contact_check(struct mpmc_sim_s *sim);
 /* begin = 1: derive the barrier's parameters once and hold them until the call with 0, at
  * the end of mpmc_sim_step (only called when sim->bodies is set) */
 void mpmc_contact_step(struct mpmc_sim_s *sim, int begin);
+/* fbar.c, F-bar's state (compiled once, not per instruction set): prepare allocates the
+ * points' Jbar (and Janc for the anchored form) and the state's arrays for the sim's form,
+ * zeroed, freeing what the form does not use (off: all of it); reserve grows the kept arrays
+ * to the particles' capacity before G2P writes them; clear zeroes the sums (what: below) and
+ * forgets a scatter. */
+enum {
+  MPMC_FBAR_CLEAR_BOX = 0,    /* over the grid's active box (the step's, before P2G)       */
+  MPMC_FBAR_CLEAR_ALL = 1,    /* over the whole grid                                       */
+  MPMC_FBAR_CLEAR_VOLUMES = 2 /* over the active box, and the records' MPMC_VSLOT there   */
+};
+int mpmc_fbar_prepare(struct mpmc_sim_s *sim);
+int mpmc_fbar_reserve(struct mpmc_sim_s *sim);
+void mpmc_fbar_clear(struct mpmc_sim_s *sim, int what);
+void mpmc_fbar_free(struct mpmc_sim_s *sim);
 /* sets.c */
 void mpmc_sets_free(struct mpmc_sim_s *sim);
 

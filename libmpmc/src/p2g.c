@@ -147,17 +147,17 @@ static void row_ranges(mpmc_grid *g, int d, int nc, const int *clo, const int *c
  * data from the other core.  The results do not depend on the runs (slabs of a colour share
  * no node). */
 static int slab_groups(mpmc_sim sim, int nt) {
-  const int ns = sim->nslab, *start = sim->slab_start;
+  const int ns = sim->scr.nslab, *start = sim->scr.slab_start;
   const size_t need = 2 * ((size_t)nt + 1);
-  if (need > (size_t)sim->cap_group) {
-    int *gr = realloc(sim->slab_group, sizeof(int) * need);
+  if (need > (size_t)sim->scr.cap_group) {
+    int *gr = realloc(sim->scr.slab_group, sizeof(int) * need);
     MPMC_CHECK(gr, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the slab runs of %d threads", nt);
-    sim->slab_group = gr;
-    sim->cap_group = (int)need;
+    sim->scr.slab_group = gr;
+    sim->scr.cap_group = (int)need;
   }
-  sim->slab_nt = nt;
+  sim->scr.slab_nt = nt;
   for (int c = 0; c < 2; ++c) {
-    int *gr = sim->slab_group + c * (nt + 1);
+    int *gr = sim->scr.slab_group + c * (nt + 1);
     long total = 0, sum = 0;
     for (int sl = c; sl < ns; sl += 2) total += start[sl + 1] - start[sl];
     int t = 0, sl = c;
@@ -196,18 +196,18 @@ static int slab_groups(mpmc_sim sim, int nt) {
 int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim, n = p->n;
+  const int d = sim->cfg.dim, n = p->n;
   if (n == 0) {
     for (int a = 0; a < 3; ++a) g->act_lo[a] = g->act_hi[a] = 0;
-    sim->nslab = 0;
+    sim->scr.nslab = 0;
     return slab_groups(sim, mpmc_max_threads()); /* empty runs, for one thread or more */
   }
   MPMC_CHECK(p->dF, sim->ctx, MPMC_ERR_STATE, "slabs: the points' fields are not allocated");
-  if (n > sim->cap_order) {
-    int *o = realloc(sim->order, sizeof(int) * (size_t)n);
+  if (n > sim->scr.cap_order) {
+    int *o = realloc(sim->scr.order, sizeof(int) * (size_t)n);
     MPMC_CHECK(o, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the slab order of %d points", n);
-    sim->order = o;
-    sim->cap_order = n;
+    sim->scr.order = o;
+    sim->scr.cap_order = n;
   }
   const int nt = mpmc_max_threads();
   const int nc = n > MPMC_OMP_MIN ? nt : 1; /* chunks */
@@ -236,7 +236,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
    * as the whole box for the next MPMC_ROWS_SKIP steps (safe: a superset) */
   const int rows = g->rows_skip <= 0;
   int clo[3] = {0, 0, 0}, chi[3] = {0, 0, 0};
-  int ax = sim->slab_axis >= 0 && sim->slab_axis < d ? sim->slab_axis : d - 1;
+  int ax = sim->scr.slab_axis >= 0 && sim->scr.slab_axis < d ? sim->scr.slab_axis : d - 1;
   for (int pass = 0; pass < 2; ++pass) {
     /* the cells holding points (the points stay within one cell of the box, g2p checks, well
      * inside the ghost layers, so the cell coordinates are positive) and the plane counts */
@@ -286,17 +286,17 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   const int per = np / (MPMC_SLAB_W * 2 * nt);
   const double share = (double)n / (2 * nt * (per < 1 ? 1 : per));
   const int cap = np / MPMC_SLAB_W + 2;
-  if (cap > sim->cap_slab) {
-    int *st = realloc(sim->slab_start, sizeof(int) * (size_t)cap);
+  if (cap > sim->scr.cap_slab) {
+    int *st = realloc(sim->scr.slab_start, sizeof(int) * (size_t)cap);
     MPMC_CHECK(st, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %d slabs", cap);
-    sim->slab_start = st;
-    sim->cap_slab = cap;
+    sim->scr.slab_start = st;
+    sim->scr.cap_slab = cap;
   }
   /* close a slab once it holds its share of the points and is at least MPMC_SLAB_W planes
    * wide (the last one may be narrower: no slab of its colour lies beyond it); the chunks'
    * counts become their fill positions: the points of plane pl go after those of the planes
    * before it, a chunk's after those of the chunks before it */
-  int *start = sim->slab_start, ns = 0, width = 0, sum = 0;
+  int *start = sim->scr.slab_start, ns = 0, width = 0, sum = 0;
   start[0] = 0;
   for (int pl = clo[ax]; pl <= chi[ax]; ++pl) {
     for (int t = 0; t < nc; ++t) {
@@ -313,7 +313,7 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
   }
   /* order[k] = k throughout (order_ident) when every run of points in one plane starts at
    * its own index: positions within a run follow the points' */
-  int *order = sim->order, ident = 1;
+  int *order = sim->scr.order, ident = 1;
 #pragma omp parallel for schedule(static, 1) num_threads(nc) if (nc > 1) reduction(& : ident)
   for (int t = 0; t < nc; ++t) {
     int *fill = cnt + (size_t)t * nmax;
@@ -332,9 +332,9 @@ int MPMC_ISA(mpmc_slabs_build)(mpmc_sim sim) {
     }
     ident &= same;
   }
-  sim->order_ident = ident;
-  sim->nslab = ns;
-  sim->slab_axis = ax;
+  sim->scr.order_ident = ident;
+  sim->scr.nslab = ns;
+  sim->scr.slab_axis = ax;
   return slab_groups(sim, nt);
 }
 
@@ -369,7 +369,7 @@ MPMC_ALWAYS_INLINE void p2g_point(mpmc_sim sim, const int DIM, const int BASIS,
   const double *W = &t->w[0][0][l], *DW = &t->dw[0][0][l]; /* node k, axis a: [AX a + 4 k] */
   const double m = p->m[q];
   const double V = p->vol0[q] * p->J[q];
-  const double vf = sim->fbar != MPMC_FBAR_STABLE ? V : 0.0;
+  const double vf = sim->cfg.fbar != MPMC_FBAR_STABLE ? V : 0.0;
   const double *s = p->stress + (size_t)q * 6;
   /* -V sigma, rows of the (symmetric) stress in the dim-dimensional subspace; being
    * symmetric, row b is also column b */
@@ -454,8 +454,8 @@ static double *private_grids(mpmc_sim sim, int nt) {
   double span = 0.0; /* the colours' duration in points */
   for (int c = 0; c < 2; ++c) {
     int total = 0, largest = 0;
-    for (int sl = c; sl < sim->nslab; sl += 2) {
-      const int k = sim->slab_start[sl + 1] - sim->slab_start[sl];
+    for (int sl = c; sl < sim->scr.nslab; sl += 2) {
+      const int k = sim->scr.slab_start[sl + 1] - sim->scr.slab_start[sl];
       total += k;
       largest = k > largest ? k : largest;
     }
@@ -467,7 +467,7 @@ static double *private_grids(mpmc_sim sim, int nt) {
 
 #define P2G_KERNEL(D, B)                                                                    \
   static void p2g_##D##_##B(mpmc_sim sim, double *priv, int nc) {                           \
-    const int *restrict order = sim->order, *restrict start = sim->slab_start;              \
+    const int *restrict order = sim->scr.order, *restrict start = sim->scr.slab_start;      \
     double *node = sim->grid.node;                                                          \
     if (priv) {                                                                             \
       const size_t per = sim->grid.nn * MPMC_NREC;                                          \
@@ -482,7 +482,7 @@ static double *private_grids(mpmc_sim sim, int nt) {
       return;                                                                               \
     }                                                                                       \
     for (int colour = 0; colour < 2; ++colour) {                                            \
-      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
+      _Pragma("omp parallel for schedule(static, 1) num_threads(sim->scr.slab_nt) if (sim->p.n > MPMC_OMP_MIN)") \
       MPMC_SLABS_OF(sim, colour, sl)                                                        \
         MPMC_BATCHES4(0, D, B, 1, 0, NULL, &sim->grid, sim->p.x, sim->p.lp, order,          \
                       start[sl], start[sl + 1], q, l, w4,                                   \

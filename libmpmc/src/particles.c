@@ -47,13 +47,6 @@ int mpmc_particles_reserve(mpmc_context ctx, mpmc_particles *p, int cap) {
   MPMC_CALL(grow(ctx, &p->cforce, d, cap));
   if (p->nustate > 0) MPMC_CALL(grow(ctx, &p->ustate, (size_t)p->nustate, cap));
   MPMC_CALL(grow(ctx, &p->dF, (size_t)d * d, cap));
-  MPMC_CALL(grow(ctx, &p->xn, d, cap));
-  MPMC_CALL(grow(ctx, &p->xoff, d, cap));
-  if (p->xnode) {
-    int *xnode = realloc(p->xnode, sizeof(int) * (size_t)cap);
-    MPMC_CHECK(xnode, ctx, MPMC_ERR_MEMORY, "cannot grow a particle field to %d points", cap);
-    p->xnode = xnode;
-  }
   p->cap = cap;
   return MPMC_SUCCESS;
 }
@@ -72,7 +65,7 @@ int mpmc_particles_ensure(mpmc_context ctx, mpmc_particles *p, double **field, i
 void mpmc_particles_free(mpmc_particles *p) {
   double **f[] = {&p->x,     &p->x0,    &p->v,  &p->m,      &p->vol0,   &p->J,
                   &p->stress, &p->Jbar, &p->Janc, &p->be, &p->eps_p, &p->region, &p->Jp, &p->pw, &p->lp,
-                  &p->force, &p->cforce, &p->ustate, &p->dF, &p->xn,  &p->xoff};
+                  &p->force, &p->cforce, &p->ustate, &p->dF};
   for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
     free(*f[i]);
     *f[i] = NULL;
@@ -81,7 +74,5 @@ void mpmc_particles_free(mpmc_particles *p) {
   p->mat = NULL;
   free(p->id);
   p->id = NULL;
-  free(p->xnode);
-  p->xnode = NULL;
   p->n = p->cap = p->nustate = 0;
 }

@@ -318,11 +318,11 @@ void **mpmc_rm_ws_slot(mpmc_rm_ws *ws, int k, void (*free_fn)(void *)) {
 }
 
 int mpmc_rm_sim_workspaces(struct mpmc_sim_s *sim, int nthreads, mpmc_rm_ws ***ws) {
-  rm_pool *pool = sim->solver_ws;
+  rm_pool *pool = sim->scr.solver_ws;
   if (!pool) {
     pool = calloc(1, sizeof *pool);
     MPMC_CHECK(pool, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the return-map workspaces");
-    sim->solver_ws = pool;
+    sim->scr.solver_ws = pool;
   }
   if (nthreads < 1) nthreads = 1;
   if (pool->n < nthreads) {
@@ -342,10 +342,10 @@ int mpmc_rm_sim_workspaces(struct mpmc_sim_s *sim, int nthreads, mpmc_rm_ws ***w
 
 /** Free the per-thread workspaces (called by mpmc_sim_destroy). */
 void mpmc_return_map_free(struct mpmc_sim_s *sim) {
-  if (!sim || !sim->solver_ws) return;
-  rm_pool *pool = sim->solver_ws;
+  if (!sim || !sim->scr.solver_ws) return;
+  rm_pool *pool = sim->scr.solver_ws;
   for (int t = 0; t < pool->n; ++t) mpmc_rm_ws_destroy(&pool->ws[t]);
   free(pool->ws);
   free(pool);
-  sim->solver_ws = NULL;
+  sim->scr.solver_ws = NULL;
 }

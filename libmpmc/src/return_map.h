@@ -157,7 +157,7 @@ int mpmc_j2_return_map_eig(mpmc_rm_ws *ws, int solver, const mpmc_j2_param *m, d
                            double *be, double *eps_p, double *tau, double *J_out,
                            mpmc_j2_info *info);
 
-/* The per-thread workspaces of a simulation (sim->solver_ws): makes sure there are
+/* The per-thread workspaces of a simulation (sim->scr.solver_ws): makes sure there are
  * at least nthreads and returns them; freed by mpmc_return_map_free. */
 /* Slots of a workspace for the other return maps' per-thread memory (their KINSOL): the
  * frictional models (return_mc.c) and the user yield surfaces (return_cpp.c). */
@@ -177,7 +177,7 @@ MPMC_J2_BATCH_PROTOTYPE(_avx2)
 MPMC_J2_BATCH_PROTOTYPE(_fma)
 MPMC_J2_BATCH_PROTOTYPE(_avx512)
 #endif
-/* The sim's set of it (kernels.c's table, sim->kernels), which material_hencky_j2.c runs. */
+/* The sim's set of it (kernels.c's table, sim->cfg.kernels), which material_hencky_j2.c runs. */
 typedef int (*mpmc_j2_batch_fn)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                                 mpmc_rm_ws **ws, int64_t *nret, int64_t *nfb, int *first_bad);
 mpmc_j2_batch_fn mpmc_kernels_j2_batch(const struct mpmc_sim_s *sim);

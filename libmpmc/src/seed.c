@@ -16,7 +16,7 @@ int mpmc_lattice_init(mpmc_sim sim, const double *bblo, const double *bbhi, int 
   MPMC_CHECK(g->valid, ctx, MPMC_ERR_STATE, "%s: set the grid before seeding", what);
   MPMC_CHECK(ppc >= 1 && ppc <= 16, ctx, MPMC_ERR_ARG,
              "%s: points per cell per axis ppc = %d must be in [1, 16]", what, ppc);
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const double tol = 1e-9 * g->h;
   lat->dim = d;
   lat->ppc = ppc;
@@ -165,8 +165,8 @@ int mpmc_sim_seed_polygon(mpmc_sim sim, int nvert, const double *xy, int ppc, in
                           int *first, int *count) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
-  MPMC_CHECK(sim->dim == 2, ctx, MPMC_ERR_ARG, "seed polygon: needs a 2D simulation (dim = %d)",
-             sim->dim);
+  MPMC_CHECK(sim->cfg.dim == 2, ctx, MPMC_ERR_ARG, "seed polygon: needs a 2D simulation (dim = %d)",
+             sim->cfg.dim);
   MPMC_CHECK(nvert >= 3, ctx, MPMC_ERR_ARG, "seed polygon: nvert = %d must be >= 3", nvert);
   MPMC_CHECK(xy, ctx, MPMC_ERR_ARG, "seed polygon: vertex array xy is NULL");
   MPMC_CHECK(material >= 0 && material < sim->nmat, ctx, MPMC_ERR_ARG,

@@ -461,7 +461,7 @@ static void bbox(const simplices *S, int d, double *lo, double *hi) {
 
 static int seed_lattice(mpmc_sim sim, const simplices *R, int ppc, int material, int *first,
                         int *count, double *spacing) {
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double lo[3], hi[3];
   bbox(R, d, lo, hi);
   mpmc_lattice lat;
@@ -495,7 +495,7 @@ static int seed_lattice(mpmc_sim sim, const simplices *R, int ppc, int material,
 static int seed_quadrature(session *s, mpmc_sim sim, int ptag, const char *region, int order,
                            int material, int *first, int *count) {
   mpmc_context ctx = sim->ctx;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   int ierr = 0, err = MPMC_SUCCESS;
   int *ents = NULL;
   size_t nent = 0, n = 0, cap = 0;
@@ -585,7 +585,7 @@ static long cell_of(const mpmc_grid *g, int a, double x, long nc) {
 
 static int buckets_build(mpmc_sim sim, int first, int count, buckets *bk) {
   const mpmc_grid *g = &sim->grid;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   size_t ncell = 1;
   bk->first = first, bk->count = count;
   for (int a = 0; a < 3; ++a) {
@@ -657,7 +657,7 @@ static void element_box(const simplices *B, const double *v, int d, double tol, 
  * vertices: their indices in *idx (malloc'ed), their number in *n. */
 static int group_points(mpmc_sim sim, const simplices *B, const char *name, const buckets *bk,
                         double spacing, int **idx, int *n) {
-  const int d = sim->dim, first = bk->first, count = bk->count;
+  const int d = sim->cfg.dim, first = bk->first, count = bk->count;
   const mpmc_grid *g = &sim->grid;
   const double *x = sim->p.x;
   unsigned char *in = calloc((size_t)(count > 0 ? count : 1), 1);
@@ -720,7 +720,7 @@ static int group_points(mpmc_sim sim, const simplices *B, const char *name, cons
  * node) touches an element, i.e. within band(h) of it; for a point group the node nearest to
  * each vertex.  Node coordinates ijk in *ijk (malloc'ed, [n][dim]). */
 static int group_nodes(mpmc_sim sim, const simplices *B, const char *name, int **ijk, int *n) {
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const mpmc_grid *g = &sim->grid;
   long nn[3] = {1, 1, 1};
   size_t total = 1;
@@ -834,7 +834,7 @@ int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode,
                    int material, int *first, int *count) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   MPMC_CHECK(file && file[0], ctx, MPMC_ERR_ARG, "gmsh: file name is NULL or empty");
   MPMC_CHECK(region && region[0], ctx, MPMC_ERR_ARG, "gmsh: region name is NULL or empty");
   MPMC_CHECK(mode == MPMC_SEED_LATTICE || mode == MPMC_SEED_QUADRATURE, ctx, MPMC_ERR_ARG,
@@ -918,7 +918,7 @@ int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode,
   /* a failure after the points were added takes them back */
   if (err && mine > 0 && sim->p.n == f0 + mine) {
     sim->p.n = f0;
-    sim->prepared = 0;
+    sim->scr.prepared = 0;
   }
   for (size_t i = 0; i < ngroup; ++i) gmshFree(groups[i].name);
   free(groups);

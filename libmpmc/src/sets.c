@@ -154,7 +154,7 @@ int mpmc_sim_add_node_set(mpmc_sim sim, const char *name, int n, const int *ijk,
   MPMC_CHECK(g->valid, ctx, MPMC_ERR_STATE, "node set '%s': set the grid first", nm);
   MPMC_CHECK(n >= 0, ctx, MPMC_ERR_ARG, "node set '%s': size n = %d must be >= 0", nm, n);
   MPMC_CHECK(n == 0 || ijk, ctx, MPMC_ERR_ARG, "node set '%s': node array ijk is NULL", nm);
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   for (int i = 0; i < n; ++i)
     for (int a = 0; a < d; ++a) {
       const int cells = g->n[a] - 1 - 2 * MPMC_GHOST, v = ijk[(size_t)i * d + a];
@@ -163,7 +163,7 @@ int mpmc_sim_add_node_set(mpmc_sim sim, const char *name, int n, const int *ijk,
                  cells);
     }
   MPMC_CALL(store_put(ctx, &sim->node_sets, "node set", name, n, d, ijk, id));
-  sim->walls_dirty = 1;
+  sim->scr.walls_dirty = 1;
   return MPMC_SUCCESS;
 }
 

@@ -20,10 +20,10 @@ int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) {
   mpmc_sim s = calloc(1, sizeof *s);
   MPMC_CHECK(s, ctx, MPMC_ERR_MEMORY, "cannot allocate a simulation");
   s->ctx = ctx;
-  s->dim = dim;
-  s->basis = MPMC_BASIS_BSPLINE2;
-  s->flip = 1.0;
-  s->solver = MPMC_SOLVER_AUTO;
+  s->cfg.dim = dim;
+  s->cfg.basis = MPMC_BASIS_BSPLINE2;
+  s->cfg.flip = 1.0;
+  s->cfg.solver = MPMC_SOLVER_AUTO;
   s->sort_last = -1;
   s->sort_axis = -1;
   s->adr_own[0] = -1; /* adaptive damping: every node its own until a step over MPI says */
@@ -50,13 +50,13 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   free(s->mats);
   free(s->wt.xh);
   free(s->walls);
-  free(s->mirrors);
-  free(s->order);
-  free(s->fb_scale);
-  free(s->slab_start);
-  free(s->slab_group);
+  free(s->scr.mirrors);
+  free(s->scr.order);
+  mpmc_fbar_free(s);
+  free(s->scr.slab_start);
+  free(s->scr.slab_group);
   free(s->adr_f);
-  free(s->adr_rows);
+  free(s->scr.adr_rows);
   free(s);
   *sim = NULL;
   return MPMC_SUCCESS;
@@ -70,7 +70,7 @@ int mpmc_sim_get_context(const mpmc_sim sim, mpmc_context *ctx) {
 
 int mpmc_sim_get_dim(const mpmc_sim sim, int *dim) {
   if (!sim || !dim) return MPMC_ERR_ARG;
-  *dim = sim->dim;
+  *dim = sim->cfg.dim;
   return MPMC_SUCCESS;
 }
 
@@ -85,11 +85,11 @@ int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h
              "the grid must be set before material points are added");
   MPMC_CHECK(!sim->node_sets || sim->node_sets->n == 0, sim->ctx, MPMC_ERR_STATE,
              "the grid must be set before node sets are added");
-  MPMC_CALL(mpmc_grid_setup(sim->ctx, &sim->grid, sim->dim, lo, hi, h));
+  MPMC_CALL(mpmc_grid_setup(sim->ctx, &sim->grid, sim->cfg.dim, lo, hi, h));
   MPMC_CALL(mpmc_dd_setup(sim)); /* MPI: the ranks' slabs of this grid */
   sim->adr_nf = 0; /* adaptive damping's node store: refilled for this grid */
-  sim->prepared = 0;
-  sim->walls_dirty = 1;
+  sim->scr.prepared = 0;
+  sim->scr.walls_dirty = 1;
   return MPMC_SUCCESS;
 }
 
@@ -97,7 +97,7 @@ int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h
 int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(sim->grid.valid, sim->ctx, MPMC_ERR_STATE, "no grid set");
-  for (int a = 0; a < sim->dim; ++a) {
+  for (int a = 0; a < sim->cfg.dim; ++a) {
     if (lo) lo[a] = sim->grid.lo[a];
     if (hi) hi[a] = sim->grid.hi[a];
   }
@@ -110,8 +110,8 @@ int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(basis >= MPMC_BASIS_LINEAR && basis <= MPMC_BASIS_BSPLINE3, sim->ctx, MPMC_ERR_ARG,
              "basis = %d is not one of linear (0), ugimp (1), bspline2 (2), bspline3 (3)", basis);
-  sim->basis = basis;
-  sim->prepared = 0;
+  sim->cfg.basis = basis;
+  sim->scr.prepared = 0;
   return MPMC_SUCCESS;
 }
 
@@ -127,14 +127,14 @@ int mpmc_sim_set_fbar(mpmc_sim sim, int mode) {
   MPMC_CHECK(mode >= MPMC_FBAR_OFF && mode <= MPMC_FBAR_ANCHORED, sim->ctx, MPMC_ERR_ARG,
              "fbar = %d is not one of off (0), paper (1), total (2), stable (3), anchored (4)",
              mode);
-  sim->fbar = mode;
-  sim->prepared = 0;
+  sim->cfg.fbar = mode;
+  sim->scr.prepared = 0;
   return MPMC_SUCCESS;
 }
 
 int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled) {
   if (!sim || !enabled) return MPMC_ERR_ARG;
-  *enabled = sim->fbar;
+  *enabled = sim->cfg.fbar;
   return MPMC_SUCCESS;
 }
 
@@ -143,7 +143,7 @@ int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(isfinite(eta) && eta >= 0 && eta <= 1, sim->ctx, MPMC_ERR_ARG,
              "FLIP/PIC blend = %g must be in [0, 1]", eta);
-  sim->flip = eta;
+  sim->cfg.flip = eta;
   return MPMC_SUCCESS;
 }
 
@@ -151,10 +151,10 @@ int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta) {
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(g, sim->ctx, MPMC_ERR_ARG, "gravity array is NULL");
-  for (int a = 0; a < sim->dim; ++a)
+  for (int a = 0; a < sim->cfg.dim; ++a)
     MPMC_CHECK(isfinite(g[a]), sim->ctx, MPMC_ERR_ARG, "gravity component %d = %g is not finite", a,
                g[a]);
-  for (int a = 0; a < 3; ++a) sim->gravity[a] = a < sim->dim ? g[a] : 0.0;
+  for (int a = 0; a < 3; ++a) sim->cfg.gravity[a] = a < sim->cfg.dim ? g[a] : 0.0;
   return MPMC_SUCCESS;
 }
 
@@ -163,7 +163,7 @@ int mpmc_sim_set_damping(mpmc_sim sim, double alpha) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(isfinite(alpha) && alpha >= 0 && alpha < 1, sim->ctx, MPMC_ERR_ARG,
              "local damping alpha = %g must be in [0, 1)", alpha);
-  sim->damping = alpha;
+  sim->cfg.damping = alpha;
   return MPMC_SUCCESS;
 }
 
@@ -176,7 +176,7 @@ int mpmc_sim_set_damping(mpmc_sim sim, double alpha) {
 int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(on == 0 || on == 1, sim->ctx, MPMC_ERR_ARG, "kinetic damping on = %d must be 0 or 1", on);
-  sim->kdamp = on;
+  sim->cfg.kdamp = on;
   sim->kd_ke = -1.0;
   return MPMC_SUCCESS;
 }
@@ -195,11 +195,11 @@ int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(isfinite(zeta) && zeta >= 0 && zeta <= 2, sim->ctx, MPMC_ERR_ARG,
              "adaptive damping ratio zeta = %g must be in [0, 2] (1: critical, 0: off)", zeta);
-  sim->adr = zeta > 0;
-  sim->adr_zeta = zeta;
+  sim->cfg.adr = zeta > 0;
+  sim->cfg.adr_zeta = zeta;
   sim->adr_c = 0.0;
   sim->adr_sum[0] = sim->adr_sum[1] = 0.0;
-  for (size_t k = 0; k < sim->adr_nf; k += (size_t)(1 + sim->dim)) sim->adr_f[k] = -2.0;
+  for (size_t k = 0; k < sim->adr_nf; k += (size_t)(1 + sim->cfg.dim)) sim->adr_f[k] = -2.0;
   return MPMC_SUCCESS;
 }
 
@@ -210,7 +210,7 @@ int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta) {
 int mpmc_sim_get_adaptive_damping(const mpmc_sim sim, double *c) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(c, sim->ctx, MPMC_ERR_ARG, "c is NULL");
-  *c = sim->adr ? sim->adr_c : 0.0;
+  *c = sim->cfg.adr ? sim->adr_c : 0.0;
   return MPMC_SUCCESS;
 }
 
@@ -219,7 +219,7 @@ int mpmc_sim_set_solver(mpmc_sim sim, int solver) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(solver >= MPMC_SOLVER_AUTO && solver <= MPMC_SOLVER_KINSOL, sim->ctx, MPMC_ERR_ARG,
              "solver = %d is not one of auto (0), newton (1), kinsol (2)", solver);
-  sim->solver = solver;
+  sim->cfg.solver = solver;
   return MPMC_SUCCESS;
 }
 
@@ -228,14 +228,14 @@ int mpmc_sim_set_threads(mpmc_sim sim, int nthreads) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(nthreads >= 0 && nthreads <= 1024, sim->ctx, MPMC_ERR_ARG,
              "threads = %d must be in [0, 1024]", nthreads);
-  sim->nthreads = nthreads;
+  sim->cfg.nthreads = nthreads;
   return MPMC_SUCCESS;
 }
 
 /** @brief Allow steps above the stability limit (1) or refuse them (0, the default). */
 int mpmc_sim_set_force_dt(mpmc_sim sim, int force) {
   if (!sim) return MPMC_ERR_ARG;
-  sim->force_dt = force != 0;
+  sim->cfg.force_dt = force != 0;
   return MPMC_SUCCESS;
 }
 
@@ -255,7 +255,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
   mpmc_context ctx = sim->ctx;
   mpmc_particles *p = &sim->p;
   const mpmc_grid *g = &sim->grid;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   MPMC_CHECK(g->valid, ctx, MPMC_ERR_STATE, "set the grid before adding material points");
   MPMC_CHECK(n >= 0, ctx, MPMC_ERR_ARG, "number of points n = %d must be >= 0", n);
   MPMC_CHECK(n == 0 || (x && volume), ctx, MPMC_ERR_ARG, "position or volume array is NULL");
@@ -271,7 +271,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
     }
     MPMC_CHECK(isfinite(volume[i]) && volume[i] > 0, ctx, MPMC_ERR_ARG,
                "point %d: volume = %g must be > 0", i, volume[i]);
-    if (sim->basis == MPMC_BASIS_UGIMP) {
+    if (sim->cfg.basis == MPMC_BASIS_UGIMP) {
       const double lp = 0.5 * pow(volume[i], 1.0 / d);
       MPMC_CHECK(lp <= 0.5 * g->h * (1 + 1e-9), ctx, MPMC_ERR_ARG,
                  "point %d: uGIMP half-length %g exceeds half a cell (%g): use at least one point per cell",
@@ -323,7 +323,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
   p->n = (int)(q + 1);
   sim->np_global += n;
   if (first) *first = n0;
-  sim->prepared = 0;
+  sim->scr.prepared = 0;
   return MPMC_SUCCESS;
 }
 
@@ -335,10 +335,10 @@ int mpmc_sim_get_num_particles(const mpmc_sim sim, int *n) {
 
 /* Allocate the optional fields and grid arrays the configuration needs. */
 int mpmc_sim_prepare(mpmc_sim sim) {
-  if (sim->prepared) return MPMC_SUCCESS;
+  if (sim->scr.prepared) return MPMC_SUCCESS;
   mpmc_context ctx = sim->ctx;
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "no grid set");
   int solid = 0, plastic = 0, region = 0;
   for (int i = 0; i < sim->nmat; ++i) {
@@ -357,46 +357,12 @@ int mpmc_sim_prepare(mpmc_sim sim) {
   if (plastic) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->eps_p, 1, 0.0));
   if (region) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->region, 1, 0.0));
   /* the plastic volume ratio: with F-bar and a frictional (dilatant) model only */
-  if (region && sim->fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jp, 1, 1.0));
+  if (region && sim->cfg.fbar) MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jp, 1, 1.0));
   if (sim->wt.kind != MPMC_WATER_NONE && !p->pw) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->pw, 1, 0.0));
     mpmc_water_update(sim);
   }
-  if (sim->fbar && !p->Jbar) {
-    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Jbar, 1, 1.0));
-    for (int q = 0; q < p->n; ++q) p->Jbar[q] = p->J[q];
-  }
-  /* the anchored form's Jacobian, anchored to the Jbar at hand (J where F-bar starts with
-   * the run); the other forms derive nothing from it: freed */
-  if (sim->fbar == MPMC_FBAR_ANCHORED && !p->Janc) {
-    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->Janc, 1, 1.0));
-    memcpy(p->Janc, p->Jbar, sizeof(double) * (size_t)p->n);
-  } else if (sim->fbar != MPMC_FBAR_ANCHORED) {
-    free(p->Janc);
-    p->Janc = NULL;
-  }
-  /* x^n for the gather (fbar.c): as positions for the stable form, as the weights' offsets
-   * and first nodes for the others (transfer.h, mpmc_kept_weights4); what the form does not
-   * use is freed */
-  const int keep_x = sim->fbar == MPMC_FBAR_STABLE, keep_w = sim->fbar && !keep_x;
-  if (keep_x) {
-    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->xn, d, 0.0));
-  } else {
-    free(p->xn);
-    p->xn = NULL;
-  }
-  if (keep_w) {
-    MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->xoff, d, 0.0));
-    if (!p->xnode) p->xnode = calloc((size_t)p->cap, sizeof(int));
-    MPMC_CHECK(p->xnode, ctx, MPMC_ERR_MEMORY, "cannot allocate a particle field for %d points",
-               p->cap);
-  } else {
-    free(p->xoff);
-    free(p->xnode);
-    p->xoff = NULL;
-    p->xnode = NULL;
-  }
-  if (sim->basis == MPMC_BASIS_UGIMP && !p->lp) {
+  if (sim->cfg.basis == MPMC_BASIS_UGIMP && !p->lp) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->lp, 1, 0.0));
     for (int q = 0; q < p->n; ++q) {
       p->lp[q] = 0.5 * pow(p->vol0[q], 1.0 / d);
@@ -406,15 +372,16 @@ int mpmc_sim_prepare(mpmc_sim sim) {
     }
   }
   MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->dF, d * d, 0.0));
-  MPMC_CALL(mpmc_grid_alloc(ctx, &sim->grid, sim->fbar));
-  sim->walls_dirty = 1;
-  sim->prepared = 1;
+  MPMC_CALL(mpmc_grid_alloc(ctx, &sim->grid));
+  MPMC_CALL(mpmc_fbar_prepare(sim)); /* Jbar, Janc and the projection's arrays, per form */
+  sim->scr.walls_dirty = 1;
+  sim->scr.prepared = 1;
   return MPMC_SUCCESS;
 }
 
 static double **field_ptr(mpmc_sim sim, int field, int *ncomp) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   switch (field) {
     case MPMC_FIELD_POSITION: *ncomp = d; return &p->x;
     case MPMC_FIELD_VELOCITY: *ncomp = d; return &p->v;
@@ -451,7 +418,7 @@ int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   MPMC_CHECK(f, sim->ctx, MPMC_ERR_ARG, "field = %d is not a particle field", field);
   if (!*f && sim->grid.valid) MPMC_CALL(mpmc_sim_prepare(sim));
   MPMC_CHECK(*f, sim->ctx, MPMC_ERR_STATE, "this simulation has no '%s' field", field_names[field]);
-  if (field == MPMC_FIELD_VELOCITY) sim->v_borrowed = 1, sim->v2max_ok = 0; /* G2P's max |v| no longer holds */
+  if (field == MPMC_FIELD_VELOCITY) sim->v_borrowed = 1, sim->scr.v2max_ok = 0; /* G2P's max |v| no longer holds */
   *data = *f;
   if (ncomp) *ncomp = nc;
   return MPMC_SUCCESS;
@@ -465,7 +432,7 @@ int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data) {
   if (data) *data = NULL;
   if (field == MPMC_FIELD_VELOCITY) { /* the caller may have written v: a pass until G2P's next */
     sim->v_borrowed = 0;
-    sim->v2max_ok = 0;
+    sim->scr.v2max_ok = 0;
   }
   return MPMC_SUCCESS;
 }
@@ -481,7 +448,7 @@ int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids) {
 int mpmc_sim_set_particle_forces(mpmc_sim sim, int first, int n, const double *f) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   MPMC_CHECK(first >= 0 && n >= 0 && first <= p->n - n, sim->ctx, MPMC_ERR_ARG,
              "points [%d, %d) outside [0, %d)", first, first + n, p->n);
   MPMC_CHECK(n == 0 || f, sim->ctx, MPMC_ERR_ARG, "force array is NULL");
@@ -510,7 +477,7 @@ int mpmc_sim_set_time(mpmc_sim sim, double t) {
 int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke) {
   if (!sim || !ke) return MPMC_ERR_ARG;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double e = 0.0;
 #pragma omp parallel for reduction(+ : e) schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) {

@@ -66,7 +66,7 @@ static void permute_ints(int *a, const int *perm, int n, double *tmp) {
 static int point_keys(const mpmc_sim sim, double *key, double *half, int *clo, int *chi) {
   const mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim, n = p->n;
+  const int d = sim->cfg.dim, n = p->n;
   for (int a = 0; a < 3; ++a) {
     clo[a] = a < d ? g->n[a] : 0;
     chi[a] = a < d ? -1 : 0;
@@ -113,7 +113,7 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   mpmc_particles *p = &sim->p;
-  const int n = p->n, d = sim->dim;
+  const int n = p->n, d = sim->cfg.dim;
   MPMC_CHECK(sim->grid.valid, ctx, MPMC_ERR_STATE, "sort: set the grid first");
   MPMC_CALL(ensure_ids(sim));
   if (n < 2) {
@@ -132,17 +132,17 @@ int mpmc_sim_sort_particles(mpmc_sim sim) {
   }
   /* the permutation (new index -> old) in the slab order array, which the next step's slab
    * build overwrites anyway */
-  if (n > sim->cap_order) {
-    int *o = realloc(sim->order, sizeof(int) * (size_t)n);
+  if (n > sim->scr.cap_order) {
+    int *o = realloc(sim->scr.order, sizeof(int) * (size_t)n);
     if (!o) {
       free(own);
       return MPMC_ERROR(ctx, MPMC_ERR_MEMORY, "sort: cannot allocate the order of %d points", n);
     }
-    sim->order = o;
-    sim->cap_order = n;
+    sim->scr.order = o;
+    sim->scr.cap_order = n;
   }
-  int *perm = sim->order;
-  sim->order_ident = 0; /* until the next slab build */
+  int *perm = sim->scr.order;
+  sim->scr.order_ident = 0; /* until the next slab build */
   int clo[3], chi[3];
   double *key = tmp, *half = tmp + n, *first = tmp + 2 * (size_t)n; /* w >= 3 columns */
   sim->sort_axis = point_keys(sim, key, half, clo, chi);
@@ -212,13 +212,13 @@ int mpmc_sim_set_sort_interval(mpmc_sim sim, int nsteps) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(nsteps >= 0, sim->ctx, MPMC_ERR_ARG, "sort interval = %d steps must be >= 0 (0: never)",
              nsteps);
-  sim->sort_every = nsteps;
+  sim->cfg.sort_every = nsteps;
   return MPMC_SUCCESS;
 }
 
 int mpmc_sim_get_sort_interval(const mpmc_sim sim, int *nsteps) {
   if (!sim || !nsteps) return MPMC_ERR_ARG;
-  *nsteps = sim->sort_every;
+  *nsteps = sim->cfg.sort_every;
   return MPMC_SUCCESS;
 }
 
@@ -232,13 +232,13 @@ int mpmc_sim_get_particle_ids(mpmc_sim sim, const int **ids) {
 
 /* step.c: sort before the step when the interval has passed */
 int mpmc_sort_due(mpmc_sim sim) {
-  if (sim->sort_every <= 0) return MPMC_SUCCESS;
+  if (sim->cfg.sort_every <= 0) return MPMC_SUCCESS;
   const int64_t since = sim->stats.steps - sim->sort_last;
   /* also soon after the slab axis changed (the last step's slab build chose another than the
    * sort's, as a collapsing body gets flatter): the storage order then no longer follows the
    * slabs; at most one such sort per tenth of the interval, should the axis go back and forth */
-  const int flip = sim->sort_axis >= 0 && sim->slab_axis != sim->sort_axis &&
-                   since >= (sim->sort_every + 9) / 10;
-  if (sim->sort_last >= 0 && since < sim->sort_every && !flip) return MPMC_SUCCESS;
+  const int flip = sim->sort_axis >= 0 && sim->scr.slab_axis != sim->sort_axis &&
+                   since >= (sim->cfg.sort_every + 9) / 10;
+  if (sim->sort_last >= 0 && since < sim->cfg.sort_every && !flip) return MPMC_SUCCESS;
   return mpmc_sim_sort_particles(sim);
 }

@@ -6,7 +6,7 @@
 
 double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   double cmax = 0.0, visc = INFINITY;
   for (int m = 0; m < sim->nmat; ++m) {
     const double c = sim->mats[m].ops->wave_speed(&sim->mats[m]);
@@ -17,8 +17,8 @@ double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor) {
     }
   }
   double vmax = 0.0;
-  if (sim->v2max_ok) {
-    vmax = sim->v2max; /* G2P's, the same sums (g2p.c) */
+  if (sim->scr.v2max_ok) {
+    vmax = sim->scr.v2max; /* G2P's, the same sums (g2p.c) */
   } else {
 #pragma omp parallel for reduction(max : vmax) schedule(static) if (p->n > MPMC_OMP_MIN)
     for (int q = 0; q < p->n; ++q) {

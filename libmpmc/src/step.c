@@ -48,14 +48,15 @@ static int step_phases(mpmc_sim sim, double dt, double *t) {
   const mpmc_kernel_set *k = mpmc_kernels_of(sim);
   if (sim->bodies) PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_update(sim, dt)); /* barrier forces */
   mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
+  if (sim->cfg.fbar) mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_BOX); /* its F-bar sums too */
   PHASE(sim, MPMC_PHASE_SLABS, t, k->slabs(sim));     /* this step's box, P2G's colouring */
   PHASE(sim, MPMC_PHASE_P2G, t, k->p2g(sim, dt));     /* mass, momentum, forces   (eqs 7, 8, 10) */
   if (sim->dd) PHASE(sim, MPMC_PHASE_P2G, t, mpmc_dd_halo(sim, MPMC_DD_NODES)); /* MPI: halo sums */
   PHASE(sim, MPMC_PHASE_GRID, t, k->grid_update(sim, dt)); /* velocities, walls, damping (eq 9) */
   PHASE(sim, MPMC_PHASE_G2P, t, k->g2p(sim, dt));     /* v, dF, J, x              (eqs 13-17)    */
-  if (sim->kdamp) mpmc_kinetic_damping(sim);          /* v = 0 at a peak of E_k (damping.c) */
-  if (sim->fbar && sim->dd) PHASE(sim, MPMC_PHASE_FBAR, t, mpmc_dd_halo(sim, MPMC_DD_FBAR));
-  if (sim->fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim, 1)); /* dF -> dF-bar (Alg. 1, 2-4)   */
+  if (sim->cfg.kdamp) mpmc_kinetic_damping(sim);          /* v = 0 at a peak of E_k (damping.c) */
+  if (sim->cfg.fbar && sim->dd) PHASE(sim, MPMC_PHASE_FBAR, t, mpmc_dd_halo(sim, MPMC_DD_FBAR));
+  if (sim->cfg.fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim, 1)); /* dF -> dF-bar (Alg. 1, 2-4)   */
   PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar);
                                    the built-in materials run F-bar's gather themselves */
   if (sim->bodies) PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_check(sim)); /* no point inside a body */
@@ -79,13 +80,13 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   MPMC_CALL(mpmc_sim_prepare(sim));
 #ifdef _OPENMP
   const int saved = omp_get_max_threads();
-  if (sim->nthreads > 0) omp_set_num_threads(sim->nthreads);
+  if (sim->cfg.nthreads > 0) omp_set_num_threads(sim->cfg.nthreads);
 #endif
   int err = MPMC_SUCCESS;
   const double t0 = now();
   double t = t0;
   if (sim->bodies) mpmc_contact_step(sim, 1); /* the barrier's parameters, once a step */
-  if (!sim->force_dt) {
+  if (!sim->cfg.force_dt) {
     const double limit = mpmc_stability_limit(sim, 1.0);
     if (!(dt <= limit))
       err = MPMC_ERROR(ctx, MPMC_ERR_UNSTABLE,
@@ -97,12 +98,13 @@ int mpmc_sim_step(mpmc_sim sim, double dt) {
   if (sim->dd) err = mpmc_dd_agree(sim, err);
   if (!err && sim->dd) err = mpmc_dd_balance_due(sim); /* MPI: cuts moved to even the points */
   if (!err) err = mpmc_sort_due(sim); /* locality: points by cell (sort.c), if asked for */
+  if (!err && sim->cfg.fbar) err = mpmc_fbar_reserve(sim); /* room for F-bar's x^n (G2P keeps it) */
   if (sim->dd) err = mpmc_dd_agree(sim, err);
   lap(sim, MPMC_PHASE_SORT, &t);
   if (!err) err = step_phases(sim, dt, &t);
   if (sim->bodies) mpmc_contact_step(sim, 0);
 #ifdef _OPENMP
-  if (sim->nthreads > 0) omp_set_num_threads(saved);
+  if (sim->cfg.nthreads > 0) omp_set_num_threads(saved);
 #endif
   if (err) return err;
   sim->time += dt;

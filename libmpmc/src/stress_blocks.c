@@ -17,7 +17,7 @@
  * point's own degree are below its 2^-54 tolerance).  A block that holds another material's
  * points or the end of the arrays goes point by point.  The blocks are fixed by the index, so
  * the results do not depend on the thread count.  The updates keep the stress guard themselves
- * (ops->checks_stress: the lowest non-finite point into sim->stress_bad, a pass over the
+ * (ops->checks_stress: the lowest non-finite point into sim->scr.stress_bad, a pass over the
  * stresses less) and run F-bar's gather when the step leaves it to them (ops->gathers_fbar,
  * MPMC_BLOCKS). */
 #include <limits.h>
@@ -39,9 +39,9 @@ static inline int block_guard(const v4 *s, int q0) {
 /* The loop of the updates over material id's points: BLOCK (an expression of q0 and sc, the
  * lowest non-finite point of the block or INT_MAX) for four of them in a row, else POINT (of q
  * and s, 0 if its stress is not finite) one by one; the lowest non-finite point into
- * sim->stress_bad.  sc: the block's F-bar factors of dF (sc[0..3]; NULL: none), s point q's
- * (1 for none).  With F-bar's gather left to the update (grid.fb_gather, fbar.c) each thread
- * first gathers its chunks' points into sim->fb_scale (their factors; Jbar becomes Pi) and
+ * sim->scr.stress_bad.  sc: the block's F-bar factors of dF (sc[0..3]; NULL: none), s point q's
+ * (1 for none).  With F-bar's gather left to the update (sim->fb.deferred, fbar.c) each thread
+ * first gathers its chunks' points into sim->fb.scale (their factors; Jbar becomes Pi) and
  * then updates them, dF-bar = s dF formed as dF is loaded, as the Hencky-J2 blocks do
  * (stress_j2.c): the two loops' static schedules over the same chunks give a thread the same
  * points, so it reads only factors it wrote (nowait).  A macro, for the OpenMP region to see
@@ -50,8 +50,8 @@ static inline int block_guard(const v4 *s, int q0) {
   do {                                                                                       \
     const int n_ = (sim)->p.n, nblk_ = (n_ + 3) / 4, *restrict m_ = (sim)->p.mat;            \
     const int nch_ = (nblk_ + MPMC_BLOCK_CHUNK - 1) / MPMC_BLOCK_CHUNK;                       \
-    const int gather_ = (sim)->grid.fb_gather;                                               \
-    double *const fs_ = (sim)->fb_scale;                                                     \
+    const int gather_ = (sim)->fb.deferred;                                                    \
+    double *const fs_ = (sim)->fb.scale;                                                     \
     int first_nf_ = INT_MAX;                                                                 \
     _Pragma("omp parallel reduction(min : first_nf_) if (n_ > MPMC_OMP_MIN)")                \
     {                                                                                        \
@@ -80,7 +80,7 @@ static inline int block_guard(const v4 *s, int q0) {
         }                                                                                    \
       }                                                                                      \
     }                                                                                        \
-    if (first_nf_ < (sim)->stress_bad) (sim)->stress_bad = first_nf_; /* stress_update.c */  \
+    if (first_nf_ < (sim)->scr.stress_bad) (sim)->scr.stress_bad = first_nf_; /* stress_update.c */ \
   } while (0)
 
 /* the block's factors (ones for none) */
@@ -163,7 +163,7 @@ static inline int nh_block(mpmc_particles *p, const int d, double mu, double lam
 int MPMC_ISA(mpmc_nh_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id, double dt) {
   (void)dt;
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const double mu = mat->G, lam = mat->lambda;
   MPMC_BLOCKS(sim, id, nh_block(p, d, mu, lam, sc, q0), nh_point(p, d, mu, lam, s, q));
   return MPMC_SUCCESS;
@@ -228,7 +228,7 @@ int MPMC_ISA(mpmc_hencky_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat
                                 double dt) {
   (void)dt;
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const double G2 = 2.0 * mat->G, kl = mat->K - G2 / 3.0;
   MPMC_BLOCKS(sim, id, hencky_block(p, d, G2, kl, sc, q0), hencky_point(p, d, G2, kl, s, q));
   return MPMC_SUCCESS;
@@ -285,9 +285,9 @@ static inline int newtonian_block(mpmc_particles *p, const int d, double K, doub
 int MPMC_ISA(mpmc_newtonian_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                                    double dt) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const double K = mat->K, mu2 = 2.0 * mat->mu, inv_dt = dt > 0 ? 1.0 / dt : 0.0;
-  const double *Jm = sim->fbar ? p->Jbar : p->J;
+  const double *Jm = sim->cfg.fbar ? p->Jbar : p->J;
   MPMC_BLOCKS(sim, id, newtonian_block(p, d, K, mu2, inv_dt, Jm, sc, q0),
               newtonian_point(p, d, K, mu2, inv_dt, Jm, s, q));
   return MPMC_SUCCESS;

@@ -104,17 +104,17 @@ static inline void plastic4(const mpmc_j2_param *m, const v4 *bt, const v4 *e, c
  * scalar return map.  *nret and *nfb count the plastic corrections and KINSOL fallbacks;
  * *first_bad is the lowest failed point (INT_MAX for none), left unchanged for
  * material_hencky_j2.c to report; the lowest point left with a non-finite stress goes into
- * sim->stress_bad (stress_update.c's guard).
+ * sim->scr.stress_bad (stress_update.c's guard).
  */
 int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
                             mpmc_rm_ws **ws, int64_t *nret_out, int64_t *nfb_out,
                             int *first_bad_out) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim, solver = sim->solver, n = p->n;
+  const int d = sim->cfg.dim, solver = sim->cfg.solver, n = p->n;
   const mpmc_j2_param par = {mat->K, mat->G, mat->kappa_p, mat->kappa_r, mat->eta};
   const double G2 = 2.0 * par.G, K = par.K;
   const int nblk = (n + 3) / 4, nchunk = (nblk + MPMC_BLOCK_CHUNK - 1) / MPMC_BLOCK_CHUNK;
-  const int gather = sim->grid.fb_gather;
+  const int gather = sim->fb.deferred;
   int64_t nret = 0, nfb = 0;
   int first_bad = INT_MAX, first_nf = INT_MAX; /* failed return map; non-finite stress */
   /* threads only pay off beyond a few hundred points (a parallel region costs ~us, far
@@ -133,8 +133,8 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
      * so a dynamic schedule balanced better; but it moved the points between the cores
      * every step, which cost more (the landslide's states at the run-out's start and 4 s
      * on two threads: the update 8.7 -> 7.7 and 9.6 -> 8.2 ms a step, docs/benchmarks.md).
-     * Chunks of MPMC_BLOCK_CHUNK blocks.  With F-bar's gather deferred to here (grid.fb_gather,
-     * fbar.c) each thread first gathers all of its chunks' points into sim->fb_scale, then
+     * Chunks of MPMC_BLOCK_CHUNK blocks.  With F-bar's gather deferred to here (sim->fb.deferred,
+     * fbar.c) each thread first gathers all of its chunks' points into sim->fb.scale, then
      * updates them, forming dF-bar = scale dF as dF is loaded; the two loops' static
      * schedules give a thread the same chunks, so it reads only factors it wrote (nowait).
      * Gathered chunk by chunk between the updates instead, the update's streams (dF, b_e,
@@ -148,7 +148,7 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
       const int b0 = ch * MPMC_BLOCK_CHUNK;
       const int b1 = b0 + MPMC_BLOCK_CHUNK < nblk ? b0 + MPMC_BLOCK_CHUNK : nblk;
       const int c0 = 4 * b0;
-      const double *scale = gather ? sim->fb_scale + c0 : NULL; /* [q - c0] */
+      const double *scale = gather ? sim->fb.scale + c0 : NULL; /* [q - c0] */
       for (int blk = b0; blk < b1; ++blk) {
         const int q0 = 4 * blk;
         int act[4], nact = 0;
@@ -299,6 +299,6 @@ int MPMC_ISA(mpmc_j2_batch)(struct mpmc_sim_s *sim, const mpmc_material *mat, in
   *nret_out = nret;
   *nfb_out = nfb;
   *first_bad_out = first_bad;
-  if (first_nf < sim->stress_bad) sim->stress_bad = first_nf; /* stress_update.c's guard */
+  if (first_nf < sim->scr.stress_bad) sim->scr.stress_bad = first_nf; /* stress_update.c's guard */
   return MPMC_SUCCESS;
 }

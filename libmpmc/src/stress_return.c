@@ -42,10 +42,10 @@ int mpmc_return_update_blocks(struct mpmc_sim_s *sim, const mpmc_material *mat, 
                               const mpmc_return_ops *ops, mpmc_return_block_fn block,
                               const void *model) {
   mpmc_particles *p = &sim->p;
-  const int d = sim->dim, solver = sim->solver;
+  const int d = sim->cfg.dim, solver = sim->cfg.solver;
   mpmc_rm_ws **ws;
   MPMC_CALL(mpmc_rm_sim_workspaces(sim, mpmc_max_threads(), &ws));
-  const double *Jm = sim->fbar ? p->Jbar : p->J;
+  const double *Jm = sim->cfg.fbar ? p->Jbar : p->J;
   const int region = (mat->model->flags & MPMC_MODEL_REGION) != 0;
   const int nblk = (p->n + 3) / 4;
   int64_t nret = 0, nfb = 0;
@@ -112,8 +112,8 @@ int mpmc_return_finish(struct mpmc_sim_s *sim, const mpmc_material *mat, int id,
   if (first_bad == INT_MAX) return MPMC_SUCCESS;
   /* the failed point, for the model to repeat alone and report what went wrong */
   const mpmc_particles *p = &sim->p;
-  const int d = sim->dim;
-  const double *Jm = sim->fbar ? p->Jbar : p->J;
+  const int d = sim->cfg.dim;
+  const double *Jm = sim->cfg.fbar ? p->Jbar : p->J;
   mpmc_return_point pt = {.q = first_bad, .eps_p = p->eps_p[first_bad], .J = Jm[first_bad]};
   mpmc_embed(d, p->dF + (size_t)pt.q * d * d, pt.F);
   for (int k = 0; k < 6; ++k) pt.be[k] = p->be[(size_t)pt.q * 6 + k];

@@ -9,25 +9,25 @@
 /** Phase 5 of the step. */
 int mpmc_stress_update(mpmc_sim sim, double dt) {
   int err = MPMC_SUCCESS, guarded = 1;
-  sim->stress_bad = INT_MAX;
+  sim->scr.stress_bad = INT_MAX;
   mpmc_water_update(sim); /* the pore pressure at the points' new positions (with a table) */
   for (int m = 0; m < sim->nmat && !err; ++m) {
     err = sim->mats[m].ops->stress_update(sim, &sim->mats[m], m, dt);
     guarded &= sim->mats[m].ops->checks_stress;
   }
-  sim->grid.fb_gather = 0; /* the materials ran F-bar's gather if the step left it to them */
+  sim->fb.deferred = 0; /* the materials ran F-bar's gather if the step left it to them */
   if (err) return err;
   const mpmc_particles *p = &sim->p;
   /* the guard: in the materials' own loops where they all keep it (Hencky-J2: a pass over
    * the stresses less), else here */
-  int first_bad = sim->stress_bad;
+  int first_bad = sim->scr.stress_bad;
   if (!guarded) {
 #pragma omp parallel for schedule(static) reduction(min : first_bad) if (p->n > MPMC_OMP_MIN)
     for (int q = 0; q < p->n; ++q)
       if (!mpmc_stress_finite(p->stress + (size_t)q * 6) && q < first_bad) first_bad = q;
   }
   if (first_bad != INT_MAX) {
-    const int q = first_bad, d = sim->dim;
+    const int q = first_bad, d = sim->cfg.dim;
     const double *x = p->x + (size_t)q * d;
     char nb[MPMC_POINT_NAME_LEN];
     return MPMC_ERROR(sim->ctx, MPMC_ERR_NUMERIC,

@@ -141,44 +141,47 @@ typedef int mpmc_b4iu __attribute__((vector_size(4 * sizeof(int)), aligned(4), m
 #define MPMC_NC (MPMC_FOFF / MPMC_VW)
 
 /* F-bar's gather (fbar.c) takes the weights of the points at x^n from what G2P kept of them
- * (g2p.c, MPMC_BATCHES4's KEEP): their offsets (axis a's at p->xoff + a p->cap) and first nodes
- * (p->xnode).  mpmc_kept_weights4: points q .. q + 3, lanes; mpmc_kept_weights1: point q, lane
- * 0.  The same bits as each other, and the weights the basis gives at those offsets. */
+ * (g2p.c, MPMC_BATCHES4's KEEP): their offsets (axis a's at f->xoff + a f->cap) and first
+ * nodes (f->xnode); lp the points' uGIMP half-lengths.  mpmc_kept_weights4: points q .. q + 3,
+ * lanes; mpmc_kept_weights1: point q, lane 0.  The same bits as each other, and the weights
+ * the basis gives at those offsets. */
 MPMC_ALWAYS_INLINE void mpmc_kept_weights4(const int DIM, const int BASIS, const mpmc_grid *g,
-                                           const mpmc_particles *p, int q, mpmc_pw4 *t) {
+                                           const mpmc_fbar_state *f, const double *lp, int q,
+                                           mpmc_pw4 *t) {
   for (int a = 0; a < DIM; ++a) {
-    const mpmc_b4d off = *(const mpmc_b4du *)(p->xoff + (size_t)a * (size_t)p->cap + (size_t)q);
+    const mpmc_b4d off = *(const mpmc_b4du *)(f->xoff + (size_t)a * (size_t)f->cap + (size_t)q);
     if (BASIS == MPMC_BASIS_UGIMP) {
-      const mpmc_b4d lv = *(const mpmc_b4du *)(p->lp + q) * g->inv_h;
+      const mpmc_b4d lv = *(const mpmc_b4du *)(lp + q) * g->inv_h;
       mpmc_ugimp_at(&off, &lv, g->inv_h, (mpmc_b4da *)t->w[a], NULL);
     } else {
       mpmc_poly_at(BASIS, &off, g->inv_h, (mpmc_b4da *)t->w[a], NULL);
     }
   }
-  const mpmc_b4l ni = __builtin_convertvector(*(const mpmc_b4iu *)(p->xnode + q), mpmc_b4l);
+  const mpmc_b4l ni = __builtin_convertvector(*(const mpmc_b4iu *)(f->xnode + q), mpmc_b4l);
   memcpy(t->node0, &ni, sizeof ni);
 }
 MPMC_ALWAYS_INLINE void mpmc_kept_weights1(const int DIM, const int BASIS, const mpmc_grid *g,
-                                           const mpmc_particles *p, int q, mpmc_pw4 *t) {
+                                           const mpmc_fbar_state *f, const double *lp, int q,
+                                           mpmc_pw4 *t) {
   for (int a = 0; a < DIM; ++a) {
     double w[MPMC_MAX_STENCIL];
-    mpmc_basis_1d_at(BASIS, p->xoff[(size_t)a * (size_t)p->cap + (size_t)q],
-                     BASIS == MPMC_BASIS_UGIMP ? p->lp[q] * g->inv_h : 0.0, w);
+    mpmc_basis_1d_at(BASIS, f->xoff[(size_t)a * (size_t)f->cap + (size_t)q],
+                     BASIS == MPMC_BASIS_UGIMP ? lp[q] * g->inv_h : 0.0, w);
     for (int k = 0; k < mpmc_stencil(BASIS); ++k) t->w[a][k][0] = w[k];
   }
-  t->node0[0] = p->xnode[q];
+  t->node0[0] = f->xnode[q];
 }
 
-/* Where G2P keeps the weights for F-bar's gather (above): the particles' xoff, axis by
- * axis, and xnode, taken once before a kernel's loops */
+/* Where G2P keeps the weights for F-bar's gather (above): F-bar's xoff, axis by axis, and
+ * xnode, taken once before a kernel's loops */
 typedef struct {
   double *off[3];
   int *node;
 } mpmc_keep;
-MPMC_ALWAYS_INLINE mpmc_keep mpmc_keep_of(mpmc_particles *p) {
-  const size_t cap = (size_t)p->cap;
-  mpmc_keep k = {{NULL, NULL, NULL}, p->xnode};
-  for (int a = 0; a < p->dim && p->xoff; ++a) k.off[a] = p->xoff + (size_t)a * cap;
+MPMC_ALWAYS_INLINE mpmc_keep mpmc_keep_of(const mpmc_fbar_state *f, int dim) {
+  const size_t cap = (size_t)f->cap;
+  mpmc_keep k = {{NULL, NULL, NULL}, f->xnode};
+  for (int a = 0; a < dim && f->xoff; ++a) k.off[a] = f->xoff + (size_t)a * cap;
   return k;
 }
 
@@ -351,7 +354,7 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights4(const int DIM, const int BASIS, con
 _Static_assert(MPMC_BASIS_BSPLINE3 == 3, "a new basis: add its kernel instances and cases");
 #define MPMC_KERNEL_CALL(fn, sim, ...)                                  \
   do {                                                                  \
-    switch (MPMC_DIM_BASIS((sim)->dim, (sim)->basis)) {                 \
+    switch (MPMC_DIM_BASIS((sim)->cfg.dim, (sim)->cfg.basis)) {         \
       case MPMC_DIM_BASIS(2, 0): fn##2_0(__VA_ARGS__); break;           \
       case MPMC_DIM_BASIS(2, 1): fn##2_1(__VA_ARGS__); break;           \
       case MPMC_DIM_BASIS(2, 2): fn##2_2(__VA_ARGS__); break;           \

@@ -35,7 +35,7 @@ double mpmc_water_pressure(const mpmc_water_table *wt, int dim, const double *x)
 void mpmc_water_update(struct mpmc_sim_s *sim) {
   mpmc_particles *p = &sim->p;
   if (!p->pw) return;
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   const mpmc_water_table *wt = &sim->wt;
 #pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)
   for (int q = 0; q < p->n; ++q) p->pw[q] = mpmc_water_pressure(wt, d, p->x + (size_t)q * d);
@@ -43,8 +43,8 @@ void mpmc_water_update(struct mpmc_sim_s *sim) {
 
 double mpmc_water_density(const struct mpmc_sim_s *sim, const mpmc_material *m, const double *x) {
   if (sim->wt.kind == MPMC_WATER_NONE) return m->rho;
-  const double h = head(&sim->wt, x[0], sim->dim == 3 ? x[1] : 0.0);
-  return x[sim->dim - 1] < h ? m->rho_sat : m->rho;
+  const double h = head(&sim->wt, x[0], sim->cfg.dim == 3 ? x[1] : 0.0);
+  return x[sim->cfg.dim - 1] < h ? m->rho_sat : m->rho;
 }
 
 int mpmc_water_set(struct mpmc_sim_s *sim, int kind, int n, const double *xh,
@@ -65,7 +65,7 @@ int mpmc_water_set(struct mpmc_sim_s *sim, int kind, int n, const double *xh,
     MPMC_CHECK(v, ctx, MPMC_ERR_MEMORY, "water table: cannot allocate %d vertices", n);
     memcpy(v, xh, sizeof *v * 2 * (size_t)n);
   } else if (kind == MPMC_WATER_PLANE) {
-    MPMC_CHECK(sim->dim == 3, ctx, MPMC_ERR_ARG,
+    MPMC_CHECK(sim->cfg.dim == 3, ctx, MPMC_ERR_ARG,
                "water table: a plane h = a + b x + c y is for 3D scenes (2D: a polyline)");
     MPMC_CHECK(isfinite(plane[0]) && isfinite(plane[1]) && isfinite(plane[2]), ctx, MPMC_ERR_ARG,
                "water table: plane (%g, %g, %g) is not finite", plane[0], plane[1], plane[2]);
@@ -84,7 +84,7 @@ int mpmc_water_set(struct mpmc_sim_s *sim, int kind, int n, const double *xh,
   } else if (p->cap) {
     MPMC_CALL(mpmc_particles_ensure(ctx, p, &p->pw, 1, 0.0));
   }
-  const int d = sim->dim;
+  const int d = sim->cfg.dim;
   if (masses)
     for (int q = 0; q < p->n; ++q)
       p->m[q] = mpmc_water_density(sim, &sim->mats[p->mat[q]], p->x + (size_t)q * d) * p->vol0[q];
