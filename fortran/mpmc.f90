@@ -381,16 +381,16 @@ module mpmc
       integer(c_int), value :: basis
       integer(c_int) :: ierr
     end function
-    function mpmc_sim_set_fbar(sim, enabled) bind(C, name='mpmc_sim_set_fbar') result(ierr)
+    function mpmc_sim_set_fbar(sim, mode) bind(C, name='mpmc_sim_set_fbar') result(ierr)
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
-      integer(c_int), value :: enabled
+      integer(c_int), value :: mode
       integer(c_int) :: ierr
     end function
-    function mpmc_sim_get_fbar(sim, enabled) bind(C, name='mpmc_sim_get_fbar') result(ierr)
+    function mpmc_sim_get_fbar(sim, mode) bind(C, name='mpmc_sim_get_fbar') result(ierr)
       import :: c_int, mpmc_sim
       type(mpmc_sim), value :: sim
-      integer(c_int), intent(out) :: enabled
+      integer(c_int), intent(out) :: mode
       integer(c_int) :: ierr
     end function
     function mpmc_sim_set_flip_blend(sim, eta) bind(C, name='mpmc_sim_set_flip_blend') result(ierr)

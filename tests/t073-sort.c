@@ -397,7 +397,7 @@ static mpmc_sim tall_block(mpmc_context ctx) {
 }
 
 /* cell coordinate of point q along axis a */
-static int cell_of(const mpmc_sim sim, int q, int a) { return (int)(sim->p.x[(size_t)q * 3 + a] * 10.0); }
+static int cell_of(mpmc_const_sim sim, int q, int a) { return (int)(sim->p.x[(size_t)q * 3 + a] * 10.0); }
 
 static void test_axis_change(void **state) {
   (void)state;
@@ -424,7 +424,7 @@ static void test_axis_change(void **state) {
     TCALL(mpmc_sim_step(b, dt));
   }
   for (int k = 0; k < 2; ++k) {
-    const mpmc_sim s = k ? b : a;
+    mpmc_const_sim s = k ? b : a;
     for (int q = 1; q < n; ++q)
       if (cell_of(s, q, 1) < cell_of(s, q - 1, 1))
         fail_msg("%s run, 5 steps after the slab axis became y: the points are not sorted by y cell (point %d)",

@@ -540,7 +540,7 @@ static void test_deferred_gather(void **state) {
 /* Point q's sum_i w_i(x) Jbar_i over the grid's nodal averages fbj at the positions xs: with
  * the weights of the stable form's space (transfer.h), or of the basis itself (the paper and
  * total forms), axis by axis as the 1D weights. */
-static double projected_at(const mpmc_sim sim, const double *xs, int q) {
+static double projected_at(mpmc_const_sim sim, const double *xs, int q) {
   const mpmc_grid *g = &sim->grid;
   const int d = sim->cfg.dim, basis = sim->cfg.basis, S = mpmc_stencil(basis);
   if (sim->cfg.fbar == MPMC_FBAR_STABLE) {

@@ -31,7 +31,7 @@ static void run(const scene *sc, int kernels, mpmc_context *pctx, mpmc_sim *psim
   test_ctx = ctx;
   TCALL(mpmc_sim_create(ctx, sc->dim, &sim));
   TCALL(mpmc_sim_set_kernels(sim, kernels));
-  int got;
+  mpmc_kernels got;
   TCALL(mpmc_sim_get_kernels(sim, &got));
   assert_int_equal(got, kernels);
   const double h = sc->dim == 2 ? 0.05 : 0.1;
@@ -182,7 +182,7 @@ static void set_get(void **state) {
   TCALL(mpmc_context_create(&ctx));
   test_ctx = ctx;
   TCALL(mpmc_sim_create(ctx, 2, &sim));
-  int k = -1;
+  mpmc_kernels k = MPMC_KERNELS_AUTO;
   TCALL(mpmc_sim_get_kernels(sim, &k));
   assert_int_equal(k, auto_set());
   TCALL(mpmc_sim_set_kernels(sim, MPMC_KERNELS_BASELINE));

@@ -67,7 +67,7 @@ static void fill(mpmc_sim sim) {
   }
 }
 
-static void save(const mpmc_sim sim, state *s) {
+static void save(mpmc_const_sim sim, state *s) {
   memcpy(s->be, sim->p.be, sizeof s->be);
   memcpy(s->eps_p, sim->p.eps_p, sizeof s->eps_p);
   memcpy(s->stress, sim->p.stress, sizeof s->stress);

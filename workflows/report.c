@@ -307,7 +307,7 @@ void wf_summary_write(const char *path, const wf_scene *sc, mpmc_sim sim, const 
           : sc->fbar == MPMC_FBAR_PAPER  ? "\"paper\""
           : sc->fbar                     ? "\"anchored\""
                                            : "false", sc->h);
-  int kern = MPMC_KERNELS_BASELINE;
+  mpmc_kernels kern = MPMC_KERNELS_BASELINE;
   mpmc_sim_get_kernels(sim, &kern);
   fprintf(f, "  \"kernels\": \"%s\",\n", mpmc_kernels_name(kern));
   int sort_every = 0;

@@ -316,7 +316,7 @@ static void log_plan(const wf_run *w) {
 #undef FEATURE
   say(w, "enabled: %s", on[0] ? on : "nothing optional");
   say(w, "left out: %s", off[0] ? off : "nothing");
-  int kern = MPMC_KERNELS_BASELINE;
+  mpmc_kernels kern = MPMC_KERNELS_BASELINE;
   if (w->sim) mpmc_sim_get_kernels(w->sim, &kern);
   say(w, "kernels: %s", kernels_detail(kern));
   char mpi[256] = "";

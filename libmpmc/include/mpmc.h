@@ -41,6 +41,8 @@ typedef enum { MPMC_ERROR_LIST(MPMC_ERROR_ENUM_) MPMC_ERROR_COUNT } mpmc_error;
 
 typedef struct mpmc_context_s *mpmc_context;
 typedef struct mpmc_sim_s *mpmc_sim;
+/* a simulation the call only reads (a mpmc_sim converts to it) */
+typedef const struct mpmc_sim_s *mpmc_const_sim;
 
 typedef enum {
   MPMC_LOG_SILENT = 0,
@@ -103,7 +105,7 @@ typedef enum {
 } mpmc_kernels;
 /* The kernel set's name as MPMC_KERNELS and summary.json spell it ("auto", "baseline",
  * "avx2", "fma", "avx512"); "unknown kernel set" outside the list. */
-const char *mpmc_kernels_name(int kernels);
+const char *mpmc_kernels_name(mpmc_kernels kernels);
 
 /* Particle fields, readable (and writable) in place.  ncomp per particle in brackets. */
 typedef enum {
@@ -141,7 +143,7 @@ typedef enum {
 } mpmc_phase;
 /* The phase's name ("sort", "slabs", "p2g", "grid", "g2p", "fbar", "stress", "checks"), as
  * summary.json keys it; "unknown phase" outside the list. */
-const char *mpmc_phase_name(int phase);
+const char *mpmc_phase_name(mpmc_phase phase);
 
 /* Run statistics, accumulated since creation. */
 typedef struct {
@@ -166,22 +168,22 @@ int mpmc_context_get_last_code(const mpmc_context ctx, int *code);
  * libraries and callbacks built on libmpmc. */
 int mpmc_context_set_error(mpmc_context ctx, int code, const char *file, int line,
                            const char *message);
-int mpmc_context_set_log_level(mpmc_context ctx, int level);
+int mpmc_context_set_log_level(mpmc_context ctx, mpmc_log_level level);
 int mpmc_version(int *major, int *minor, int *patch);
 
 /* ---- simulation set-up ----------------------------------------------------- */
 int mpmc_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim);
 int mpmc_sim_destroy(mpmc_sim *sim);
-int mpmc_sim_get_context(const mpmc_sim sim, mpmc_context *ctx);
-int mpmc_sim_get_dim(const mpmc_sim sim, int *dim);
+int mpmc_sim_get_context(mpmc_const_sim sim, mpmc_context *ctx);
+int mpmc_sim_get_dim(mpmc_const_sim sim, int *dim);
 /* Uniform grid covering the box [lo, hi] with cells of size h; (hi - lo)/h is rounded up
  * to whole cells.  Ghost layers outside the box are added internally so that every basis
  * has full support for material points inside the box. */
 int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h);
-int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h);
-int mpmc_sim_set_basis(mpmc_sim sim, int basis);
-int mpmc_sim_set_fbar(mpmc_sim sim, int mode); /* mpmc_fbar_mode (scenes: ANCHORED) */
-int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled);
+int mpmc_sim_get_grid(mpmc_const_sim sim, double *lo, double *hi, double *h);
+int mpmc_sim_set_basis(mpmc_sim sim, mpmc_basis basis);
+int mpmc_sim_set_fbar(mpmc_sim sim, mpmc_fbar_mode mode); /* scenes: ANCHORED */
+int mpmc_sim_get_fbar(mpmc_const_sim sim, mpmc_fbar_mode *mode);
 int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
 int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
@@ -191,7 +193,7 @@ int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on); /* 0 off, 1 on */
  * estimated each step by a Rayleigh quotient over the grid; zeta in [0, 2], 1 critical,
  * 0 off (not over MPI yet).  get: the c [1/s] the next step applies. */
 int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta);
-int mpmc_sim_get_adaptive_damping(const mpmc_sim sim, double *c);
+int mpmc_sim_get_adaptive_damping(mpmc_const_sim sim, double *c);
 /* A water table: hydrostatic pore pressure p = gamma_w max(0, h - z) below the piezometric
  * elevation h (z: the last coordinate, gravity along -z).  h is a polyline of n vertices
  * xh = {x0, h0, x1, h1, ...} over x with x increasing (2D; in 3D the same across y), held
@@ -209,11 +211,11 @@ int mpmc_sim_set_water_table_plane(mpmc_sim sim, double a, double b, double c, d
  * elastic strain that carries them.  Points of models without Hencky elasticity are left
  * as they are. */
 int mpmc_sim_set_geostatic_stress(mpmc_sim sim, double k0);
-int mpmc_sim_set_solver(mpmc_sim sim, int solver);
+int mpmc_sim_set_solver(mpmc_sim sim, mpmc_solver solver);
 int mpmc_sim_set_threads(mpmc_sim sim, int nthreads);
-int mpmc_sim_set_kernels(mpmc_sim sim, int kernels);      /* mpmc_kernels */
+int mpmc_sim_set_kernels(mpmc_sim sim, mpmc_kernels kernels);
 /* the set in use: BASELINE, AVX2, FMA or AVX512 */
-int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels);
+int mpmc_sim_get_kernels(mpmc_const_sim sim, mpmc_kernels *kernels);
 
 /* ---- materials; each returns its id ----------------------------------------- */
 int mpmc_sim_add_material_neo_hookean(mpmc_sim sim, double E, double nu, double rho, int *id);
@@ -242,13 +244,13 @@ typedef enum {
 } mpmc_dp_match;
 int mpmc_sim_add_material_drucker_prager(mpmc_sim sim, double E, double nu, double rho, double c,
                                          double phi, double psi, double c_r, double phi_r,
-                                         double psi_r, double eta, double sigma_t, int match,
-                                         int *id);
+                                         double psi_r, double eta, double sigma_t,
+                                         mpmc_dp_match match, int *id);
 /* The paper's strength reduction factor (landslide trigger), for mpmc_sim_reduce_strength. */
 #define MPMC_DEFAULT_STRENGTH_REDUCTION 1.65
 /* Nearly incompressible Newtonian fluid: p = -K (J - 1), deviatoric 2 mu dev(D). */
 int mpmc_sim_add_material_newtonian(mpmc_sim sim, double K, double mu, double rho, int *id);
-int mpmc_sim_get_num_materials(const mpmc_sim sim, int *n);
+int mpmc_sim_get_num_materials(mpmc_const_sim sim, int *n);
 /* Divide the strengths of a plastic material by factor (J2: kappa_p, kappa_r; Mohr-Coulomb
  * and Drucker-Prager: c, tan phi, tan psi and the tension cut-off); material = -1 for every
  * plastic material.  Factors compose.  Accumulated plastic strain is kept. */
@@ -290,7 +292,7 @@ int mpmc_sim_add_material(mpmc_sim sim, const char *model, const double *par, in
 /* A material's model, current (strength-reduced) parameters and reduction factor; par holds
  * MPMC_MAX_PARAMS values (any may be NULL). */
 #define MPMC_MAX_PARAMS 16
-int mpmc_sim_get_material(const mpmc_sim sim, int material, int *model, double *par,
+int mpmc_sim_get_material(mpmc_const_sim sim, int material, int *model, double *par,
                           double *factor);
 
 /* ---- material points ------------------------------------------------------- */
@@ -298,14 +300,14 @@ int mpmc_sim_get_material(const mpmc_sim sim, int material, int *model, double *
  * Mass = rho * volume.  *first (may be NULL) receives the index of the first new point. */
 int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *volume,
                            int material, int *first);
-int mpmc_sim_get_num_particles(const mpmc_sim sim, int *n);
+int mpmc_sim_get_num_particles(mpmc_const_sim sim, int *n);
 /* Borrow a particle field in place (no copy); give it back with restore.  Fields a scene
  * does not have (e.g. EPS_P without a plastic material) are MPMC_ERR_STATE.  The pointer
  * stays the field across steps and sorts until points are added (the arrays may move).
  * While the velocity is on loan (until its restore) the stability limit of each step takes a
  * pass over the points for max |v| instead of the one G2P found. */
-int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp);
-int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data);
+int mpmc_sim_get_field(mpmc_sim sim, mpmc_field field, double **data, int *ncomp);
+int mpmc_sim_restore_field(mpmc_sim sim, mpmc_field field, double **data);
 int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids);
 /* Sorting the points by grid cell for locality (the transfers' caches): off by default, so
  * a point keeps the index it was added with.  With nsteps > 0 the step sorts every nsteps
@@ -314,7 +316,7 @@ int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids);
  * Field pointers stay valid (the arrays are permuted in place).  Results change only by the
  * summation order at the nodes; the sort does not depend on the thread count. */
 int mpmc_sim_set_sort_interval(mpmc_sim sim, int nsteps);
-int mpmc_sim_get_sort_interval(const mpmc_sim sim, int *nsteps);
+int mpmc_sim_get_sort_interval(mpmc_const_sim sim, int *nsteps);
 int mpmc_sim_sort_particles(mpmc_sim sim); /* sort now */
 int mpmc_sim_get_particle_ids(mpmc_sim sim, const int **ids);
 /* External force on points [first, first+n): f[n*dim] (a traction times its tributary
@@ -325,17 +327,19 @@ int mpmc_sim_set_particle_forces(mpmc_sim sim, int first, int n, const double *f
 /* A wall constrains every grid node on or beyond the plane x[axis] = position:
  * side = -1 constrains nodes with x[axis] <= position (material on the + side),
  * side = +1 nodes with x[axis] >= position. */
-int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, int kind, int *id);
+int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, mpmc_wall_kind kind,
+                      int *id);
 /* A wall on a face of the grid box: face = 2*axis + (0 for lo, 1 for hi). */
-int mpmc_sim_add_wall_face(mpmc_sim sim, int face, int kind, int *id);
+int mpmc_sim_add_wall_face(mpmc_sim sim, int face, mpmc_wall_kind kind, int *id);
 /* Constrain the nodes inside the axis-aligned box [lo, hi] (gates, obstacles);
  * for SLIP and SEPARABLE the constrained component is `axis`, with material on side
  * -side (side -1: material is at larger x[axis]). */
-int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, int kind, int axis,
-                          int side, int *id);
+int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, mpmc_wall_kind kind,
+                          int axis, int side, int *id);
 /* Constrain the nodes of a node set (mpmc_sim_add_node_set, or a gmsh boundary group);
  * axis and side as for a box.  Plain constraint: no ghost mirroring. */
-int mpmc_sim_add_wall_nodes(mpmc_sim sim, int set, int kind, int axis, int side, int *id);
+int mpmc_sim_add_wall_nodes(mpmc_sim sim, int set, mpmc_wall_kind kind, int axis, int side,
+                            int *id);
 int mpmc_sim_remove_wall(mpmc_sim sim, int id);
 
 /* ---- time stepping ---------------------------------------------------------- */
@@ -345,10 +349,10 @@ int mpmc_sim_stable_dt(mpmc_sim sim, double factor, double *dt);
  * h / c unless mpmc_sim_set_force_dt(sim, 1). */
 int mpmc_sim_step(mpmc_sim sim, double dt);
 int mpmc_sim_set_force_dt(mpmc_sim sim, int force);
-int mpmc_sim_get_time(const mpmc_sim sim, double *t);
+int mpmc_sim_get_time(mpmc_const_sim sim, double *t);
 int mpmc_sim_set_time(mpmc_sim sim, double t);
-int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke);
-int mpmc_sim_get_stats(const mpmc_sim sim, mpmc_stats *stats);
+int mpmc_sim_get_kinetic_energy(mpmc_const_sim sim, double *ke);
+int mpmc_sim_get_stats(mpmc_const_sim sim, mpmc_stats *stats);
 
 /* ---- run monitor (monitor.c) ---------------------------------------------------------- */
 /* Every step is checked: NaN/Inf or J <= 0 (MPMC_ERR_NUMERIC), a point leaving the grid
@@ -377,24 +381,24 @@ int mpmc_sim_add_rigid_polygon(mpmc_sim sim, int nvert, const double *xy, double
 int mpmc_sim_remove_rigid(mpmc_sim sim, int id);
 int mpmc_sim_set_rigid_velocity(mpmc_sim sim, int id, const double *v);
 /* Displacement of the body since it was added. */
-int mpmc_sim_get_rigid_offset(const mpmc_sim sim, int id, double *offset);
+int mpmc_sim_get_rigid_offset(mpmc_const_sim sim, int id, double *offset);
 /* Force of the points on the body in the last step (per unit thickness in 2D). */
-int mpmc_sim_get_rigid_reaction(const mpmc_sim sim, int id, double *f);
+int mpmc_sim_get_rigid_reaction(mpmc_const_sim sim, int id, double *f);
 /* Smallest signed distance of any point to the body (negative inside) and that point. */
-int mpmc_sim_get_rigid_gap(const mpmc_sim sim, int id, double *gap, int *point);
+int mpmc_sim_get_rigid_gap(mpmc_const_sim sim, int id, double *gap, int *point);
 /* Barrier range dhat [m] and stiffness kappa [Pa/m] for all bodies; 0 = derived default. */
 int mpmc_sim_set_contact_params(mpmc_sim sim, double dhat, double kappa);
-int mpmc_sim_get_contact_params(const mpmc_sim sim, double *dhat, double *kappa);
+int mpmc_sim_get_contact_params(mpmc_const_sim sim, double *dhat, double *kappa);
 
 /* ---- named particle sets (sets.c) ---------------------------------------------- */
 /* Sets name groups of points (gmsh boundary groups, traction edges, tracked points).
  * Adding a set with an existing name replaces it.  Indices are copied. */
 int mpmc_sim_add_particle_set(mpmc_sim sim, const char *name, int n, const int *idx, int *id);
-int mpmc_sim_get_num_particle_sets(const mpmc_sim sim, int *n);
+int mpmc_sim_get_num_particle_sets(mpmc_const_sim sim, int *n);
 /* Borrow set `id`: its name, size and indices (valid until the sets change). */
-int mpmc_sim_get_particle_set(const mpmc_sim sim, int id, const char **name, int *n,
+int mpmc_sim_get_particle_set(mpmc_const_sim sim, int id, const char **name, int *n,
                               const int **idx);
-int mpmc_sim_find_particle_set(const mpmc_sim sim, const char *name, int *id);
+int mpmc_sim_find_particle_set(mpmc_const_sim sim, const char *name, int *id);
 
 /* ---- named node sets (sets.c) ------------------------------------------------------ */
 /* Grid nodes by integer coordinates ijk[n*dim]: node (i, j, k) sits at lo + (i, j, k) h,
@@ -402,9 +406,9 @@ int mpmc_sim_find_particle_set(const mpmc_sim sim, const char *name, int *id);
  * whose cell of influence, a square/cube of side h centred on the node, touches the group).
  * Adding a set with an existing name replaces it.  Needs the grid; kept in checkpoints. */
 int mpmc_sim_add_node_set(mpmc_sim sim, const char *name, int n, const int *ijk, int *id);
-int mpmc_sim_get_num_node_sets(const mpmc_sim sim, int *n);
-int mpmc_sim_get_node_set(const mpmc_sim sim, int id, const char **name, int *n, const int **ijk);
-int mpmc_sim_find_node_set(const mpmc_sim sim, const char *name, int *id);
+int mpmc_sim_get_num_node_sets(mpmc_const_sim sim, int *n);
+int mpmc_sim_get_node_set(mpmc_const_sim sim, int id, const char **name, int *n, const int **ijk);
+int mpmc_sim_find_node_set(mpmc_const_sim sim, const char *name, int *id);
 
 /* ---- seeding without gmsh (seed.c) --------------------------------------------- */
 /* ppc points per cell per axis on the sim's grid lattice, kept where they fall inside
@@ -426,7 +430,7 @@ int mpmc_output_destroy(mpmc_output *out);
 /* ---- checkpoint and restart (checkpoint.c) ------------------------------------------ */
 /* Everything needed to continue the run, written atomically (temporary file, fsync,
  * rename).  meta: caller's text stored alongside (e.g. the workflow's stage), may be NULL. */
-int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *meta);
+int mpmc_sim_checkpoint_write(mpmc_const_sim sim, const char *path, const char *meta);
 /* Create a simulation from a checkpoint; *meta (may be NULL) receives a copy of the
  * caller's text, to be released with mpmc_free. */
 int mpmc_sim_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);

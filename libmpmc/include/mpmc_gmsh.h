@@ -20,7 +20,7 @@ typedef enum {
  * 3D) and physical point groups become particle sets named after the groups, and node sets
  * of the grid nodes near them (for walls: mpmc_sim_add_wall_nodes).  On failure nothing is
  * added. */
-int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
+int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, mpmc_seed_mode mode, int ppc,
                    int material, int *first, int *count);
 
 #ifdef __cplusplus

@@ -33,13 +33,13 @@ int mpmc_sim_checkpoint_read_mpi_f(mpmc_context ctx, MPI_Fint comm, const char *
  * and the slab's cells [cell_lo, cell_hi) along it (grid cell 0 is the first ghost cell
  * below the box; a load balance moves them); the simulation's grid must be set.  Any
  * argument may be NULL. */
-int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis, int *cell_lo,
+int mpmc_sim_get_mpi_slab(mpmc_const_sim sim, int *rank, int *nranks, int *axis, int *cell_lo,
                           int *cell_hi);
 /* What this rank sent since the simulation was created: the bytes (payload) and messages of
  * the halo sums (after P2G, and F-bar's after G2P), and of migration (points moving to
  * another rank's slab, their counts included).  A message to a neighbour counts even when
  * empty; ranks at the ends send to one neighbour.  Any argument may be NULL. */
-int mpmc_sim_get_mpi_traffic(const mpmc_sim sim, double *halo_bytes, long *halo_msgs,
+int mpmc_sim_get_mpi_traffic(mpmc_const_sim sim, double *halo_bytes, long *halo_msgs,
                              double *migrated_bytes, long *migrate_msgs);
 /* Load balance: before a step, when every_n_steps steps passed since the last balance
  * (0: never by count) or when the most points on a rank exceed threshold times the mean
@@ -50,7 +50,7 @@ int mpmc_sim_get_mpi_traffic(const mpmc_sim sim, double *halo_bytes, long *halo_
 int mpmc_sim_set_mpi_balance(mpmc_sim sim, int every_n_steps, double threshold);
 /* The most points on a rank over the mean over the ranks (1: even), and the balances done
  * so far (cuts moved).  Collective; either argument may be NULL. */
-int mpmc_sim_get_mpi_imbalance(const mpmc_sim sim, double *imbalance, long *balances);
+int mpmc_sim_get_mpi_imbalance(mpmc_const_sim sim, double *imbalance, long *balances);
 
 #ifdef __cplusplus
 }

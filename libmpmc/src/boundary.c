@@ -37,7 +37,8 @@ static int check_kind_axis_side(mpmc_sim sim, int kind, int axis, int side) {
  * @param kind mpmc_wall_kind
  * @param[out] id the wall's id, for mpmc_sim_remove_wall (may be NULL)
  */
-int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, int kind, int *id) {
+int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, mpmc_wall_kind kind,
+                      int *id) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CALL(check_kind_axis_side(sim, kind, axis, side));
   MPMC_CHECK(isfinite(position), sim->ctx, MPMC_ERR_ARG, "wall position = %g is not finite",
@@ -57,7 +58,7 @@ int mpmc_sim_add_wall(mpmc_sim sim, int axis, int side, double position, int kin
 /**
  * @brief Add a wall on a face of the grid box: face = 2*axis + (0: lo, 1: hi).
  */
-int mpmc_sim_add_wall_face(mpmc_sim sim, int face, int kind, int *id) {
+int mpmc_sim_add_wall_face(mpmc_sim sim, int face, mpmc_wall_kind kind, int *id) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(sim->grid.valid, sim->ctx, MPMC_ERR_STATE, "set the grid before adding face walls");
   MPMC_CHECK(face >= 0 && face < 2 * sim->cfg.dim, sim->ctx, MPMC_ERR_ARG,
@@ -73,8 +74,8 @@ int mpmc_sim_add_wall_face(mpmc_sim sim, int face, int kind, int *id) {
  * @param side for SEPARABLE, -1 if the material lies at larger x[axis] (it may move away
  *        in +axis), +1 if at smaller
  */
-int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, int kind, int axis,
-                          int side, int *id) {
+int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, mpmc_wall_kind kind,
+                          int axis, int side, int *id) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CALL(check_kind_axis_side(sim, kind, axis, side));
   MPMC_CHECK(lo && hi, sim->ctx, MPMC_ERR_ARG, "wall box lo/hi arrays are NULL");
@@ -94,7 +95,8 @@ int mpmc_sim_add_wall_box(mpmc_sim sim, const double *lo, const double *hi, int 
  * @param axis, side as for mpmc_sim_add_wall_box: the constrained component for SLIP and
  *        SEPARABLE, and for SEPARABLE the side the material lies on
  */
-int mpmc_sim_add_wall_nodes(mpmc_sim sim, int set, int kind, int axis, int side, int *id) {
+int mpmc_sim_add_wall_nodes(mpmc_sim sim, int set, mpmc_wall_kind kind, int axis, int side,
+                            int *id) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CALL(check_kind_axis_side(sim, kind, axis, side));
   const int ns = sim->node_sets ? sim->node_sets->n : 0;

@@ -158,7 +158,7 @@ static int select_rows(hid_t g, mpmc_sim sim, ckpt_rows *k) {
  * node from the rank whose slab holds its plane (damping.c: a node with mass last step holds
  * the same values on every rank that has it), the others' zero, summed over the ranks.  A
  * restart on any number of ranks then finds every node's last force.  NULL: no memory. */
-static double *adaptive_nodes(const mpmc_sim sim) {
+static double *adaptive_nodes(mpmc_const_sim sim) {
   if (!sim->dd || sim->adr_own[0] < 0) return sim->adr_f;
   double *a = malloc(sim->adr_nf * sizeof *a);
   if (!a) return NULL;
@@ -172,7 +172,7 @@ static double *adaptive_nodes(const mpmc_sim sim) {
   return a;
 }
 
-static int write_config(hid_t f, const mpmc_sim sim) {
+static int write_config(hid_t f, mpmc_const_sim sim) {
   hid_t g = H5Gcreate2(f, "config", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) return -1;
   const mpmc_grid *gr = &sim->grid;
@@ -421,7 +421,7 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
 #define NPARAM MPMC_MAX_PARAM
 #define NAME_LEN 32
 
-static int write_materials(hid_t f, const mpmc_sim sim) {
+static int write_materials(hid_t f, mpmc_const_sim sim) {
   const int nm = sim->nmat;
   const size_t nr = (size_t)(nm > 0 ? nm : 1);
   double *par = calloc(NPARAM * nr, sizeof(double)), *srm = calloc(nr, sizeof(double));
@@ -583,7 +583,7 @@ static int pfield_ncomp(const mpmc_particles *p, const pfield *f) {
 
 /* Over MPI each rank writes its points as the rows from its offset, in its storage order;
  * a field some rank has is written by all (the others' rows filled as the field starts). */
-static int write_particles(hid_t f, const mpmc_sim sim) {
+static int write_particles(hid_t f, mpmc_const_sim sim) {
   mpmc_particles *p = (mpmc_particles *)&sim->p;
   long long off = 0, total = 0;
   mpmc_io_scan(sim, p->n, &off, &total);
@@ -705,7 +705,7 @@ static int read_particles(hid_t f, mpmc_sim sim, ckpt_rows *k) {
 
 #define WALLCOLS 10 /* active kind axis side lo[3] hi[3] */
 
-static int write_walls(hid_t f, const mpmc_sim sim) {
+static int write_walls(hid_t f, mpmc_const_sim sim) {
   const int nw = sim->nwall;
   double *w = malloc(sizeof(double) * WALLCOLS * (size_t)(nw > 0 ? nw : 1));
   if (!w) return -1;
@@ -779,7 +779,7 @@ static int read_walls(hid_t f, mpmc_sim sim, ckpt_rows *k) {
  * coordinates), named by number, with the set's name as an attribute. */
 /* Over MPI the particle sets' members are the rows of the points in /particles (each rank's
  * from its offset), rank after rank; node sets are the same on every rank. */
-static int write_set_group(hid_t f, const mpmc_sim sim, const char *gname,
+static int write_set_group(hid_t f, mpmc_const_sim sim, const char *gname,
                            const struct mpmc_sets_s *S, int ncomp) {
   hid_t g = H5Gcreate2(f, gname, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) return -1;
@@ -813,7 +813,7 @@ static int write_set_group(hid_t f, const mpmc_sim sim, const char *gname,
   return st < 0 ? -1 : 0;
 }
 
-static int write_sets(hid_t f, const mpmc_sim sim) {
+static int write_sets(hid_t f, mpmc_const_sim sim) {
   if (write_set_group(f, sim, "sets", sim->sets, 1) < 0) return -1;
   return write_set_group(f, sim, "node_sets", sim->node_sets, sim->cfg.dim);
 }
@@ -887,7 +887,7 @@ static int read_sets(hid_t f, mpmc_sim sim, ckpt_rows *k) {
 /* Body i's friction anchors over MPI: a row per point ([points][3]), each rank's from its
  * offset in /particles; points beyond the anchors' count (added since the last contact
  * pass) start at zero, as mpmc_contact_grow_anchors starts them. */
-static herr_t write_anchors_mpi(hid_t g, const mpmc_sim sim, int i) {
+static herr_t write_anchors_mpi(hid_t g, mpmc_const_sim sim, int i) {
   const mpmc_body *b = &sim->bodies->b[i];
   const int n = sim->p.n;
   long long off = 0, total = 0;
@@ -906,7 +906,7 @@ static herr_t write_anchors_mpi(hid_t g, const mpmc_sim sim, int i) {
   return st;
 }
 
-static int write_bodies(hid_t f, const mpmc_sim sim) {
+static int write_bodies(hid_t f, mpmc_const_sim sim) {
   const struct mpmc_bodies_s *B = sim->bodies;
   const int present = B != NULL, nb = B ? B->n : 0;
   const double par[2] = {B ? B->dhat : 0.0, B ? B->kappa : 0.0};
@@ -1132,7 +1132,7 @@ static int checksum(hid_t f, uint64_t *h) {
 
 typedef struct {
   const char *name;
-  int (*write)(hid_t f, const mpmc_sim sim); /* < 0 on an HDF5 failure             */
+  int (*write)(hid_t f, mpmc_const_sim sim); /* < 0 on an HDF5 failure             */
   int (*read)(hid_t f, mpmc_sim sim, ckpt_rows *k); /* an MPMC error code with a message */
 } block;
 
@@ -1151,7 +1151,7 @@ static const block blocks[] = {{"config", write_config, read_config},
  *        left as it was.
  * @param meta the caller's text stored alongside (e.g. the workflow stage), may be NULL
  */
-int mpmc_sim_checkpoint_write(const mpmc_sim sim, const char *path, const char *meta) {
+int mpmc_sim_checkpoint_write(mpmc_const_sim sim, const char *path, const char *meta) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;
   MPMC_CHECK(path && path[0], ctx, MPMC_ERR_ARG, "checkpoint path is NULL or empty");

@@ -432,7 +432,7 @@ static int check_mu(mpmc_sim sim, double mu) {
   return MPMC_SUCCESS;
 }
 
-static int get_body(const mpmc_sim sim, int id, mpmc_body **b) {
+static int get_body(mpmc_const_sim sim, int id, mpmc_body **b) {
   const struct mpmc_bodies_s *B = sim->bodies;
   MPMC_CHECK(B && id >= 0 && id < B->n && B->b[id].active, sim->ctx, MPMC_ERR_ARG,
              "rigid body id %d does not exist or was removed (%d bodies)", id, B ? B->n : 0);
@@ -528,7 +528,7 @@ int mpmc_sim_set_rigid_velocity(mpmc_sim sim, int id, const double *v) {
 }
 
 /** @brief The displacement offset[dim] of a rigid body since it was added. */
-int mpmc_sim_get_rigid_offset(const mpmc_sim sim, int id, double *offset) {
+int mpmc_sim_get_rigid_offset(mpmc_const_sim sim, int id, double *offset) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_body *b = NULL;
   MPMC_CALL(get_body(sim, id, &b));
@@ -541,7 +541,7 @@ int mpmc_sim_get_rigid_offset(const mpmc_sim sim, int id, double *offset) {
  * @brief The force f[dim] the material points exerted on a rigid body in the last step
  *        (minus the sum of the contact forces on the points; per unit thickness in 2D).
  */
-int mpmc_sim_get_rigid_reaction(const mpmc_sim sim, int id, double *f) {
+int mpmc_sim_get_rigid_reaction(mpmc_const_sim sim, int id, double *f) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_body *b = NULL;
   MPMC_CALL(get_body(sim, id, &b));
@@ -555,7 +555,7 @@ int mpmc_sim_get_rigid_reaction(const mpmc_sim sim, int id, double *f) {
  *        (negative inside) and that point (-1 and +inf without points); over MPI the
  *        smallest over every rank's points and the point's global id (collective).
  */
-int mpmc_sim_get_rigid_gap(const mpmc_sim sim, int id, double *gap, int *point) {
+int mpmc_sim_get_rigid_gap(mpmc_const_sim sim, int id, double *gap, int *point) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_body *b = NULL;
   MPMC_CALL(get_body(sim, id, &b));
@@ -593,7 +593,7 @@ int mpmc_sim_set_contact_params(mpmc_sim sim, double dhat, double kappa) {
 }
 
 /** @brief The barrier's range dhat and stiffness kappa in effect (defaults resolved). */
-int mpmc_sim_get_contact_params(const mpmc_sim sim, double *dhat, double *kappa) {
+int mpmc_sim_get_contact_params(mpmc_const_sim sim, double *dhat, double *kappa) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(sim->grid.valid, sim->ctx, MPMC_ERR_STATE,
              "the contact defaults need a grid (set it first)");

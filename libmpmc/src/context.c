@@ -5,6 +5,19 @@
 
 #include "mpmc_impl.h"
 
+/* The API's enums travel to and from Fortran as integer(c_int) (fortran/mpmc.f90) */
+#define MPMC_INT_SIZED(e) _Static_assert(sizeof(e) == sizeof(int), #e " is not int-sized")
+MPMC_INT_SIZED(mpmc_error);
+MPMC_INT_SIZED(mpmc_log_level);
+MPMC_INT_SIZED(mpmc_basis);
+MPMC_INT_SIZED(mpmc_wall_kind);
+MPMC_INT_SIZED(mpmc_fbar_mode);
+MPMC_INT_SIZED(mpmc_solver);
+MPMC_INT_SIZED(mpmc_kernels);
+MPMC_INT_SIZED(mpmc_field);
+MPMC_INT_SIZED(mpmc_phase);
+MPMC_INT_SIZED(mpmc_dp_match);
+
 /**
  * @brief Create a context.
  * @param[out] ctx the new context
@@ -55,7 +68,7 @@ int mpmc_context_clear_error(mpmc_context ctx) {
 }
 
 /** @brief Set the log level (mpmc_log_level); messages go to stderr. */
-int mpmc_context_set_log_level(mpmc_context ctx, int level) {
+int mpmc_context_set_log_level(mpmc_context ctx, mpmc_log_level level) {
   if (!ctx) return MPMC_ERR_ARG;
   MPMC_CHECK(level >= MPMC_LOG_SILENT && level <= MPMC_LOG_DEBUG, ctx, MPMC_ERR_ARG,
              "log level %d outside [0, 4]", level);

@@ -65,7 +65,7 @@ static int use_kernels(mpmc_sim s, int request, const char *what) {
  * @brief The name of a kernel set (mpmc_kernels) as MPMC_KERNELS and summary.json spell it,
  *        a static string.
  */
-const char *mpmc_kernels_name(int kernels) {
+const char *mpmc_kernels_name(mpmc_kernels kernels) {
   static const char *const names[] = {"auto", "baseline", "avx2", "fma", "avx512"};
   return kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_AVX512 ? names[kernels]
                                                                         : "unknown kernel set";
@@ -97,7 +97,7 @@ int mpmc_kernels_from_env(mpmc_sim s) {
  *        and FMA where this build or processor has no AVX2 kernels, for AVX512 where it has
  *        no AVX-512 ones)
  */
-int mpmc_sim_set_kernels(mpmc_sim sim, int kernels) {
+int mpmc_sim_set_kernels(mpmc_sim sim, mpmc_kernels kernels) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(kernels >= MPMC_KERNELS_AUTO && kernels <= MPMC_KERNELS_AVX512, sim->ctx,
              MPMC_ERR_ARG,
@@ -109,7 +109,7 @@ int mpmc_sim_set_kernels(mpmc_sim sim, int kernels) {
 }
 
 /** @brief The kernel set the step runs: MPMC_KERNELS_BASELINE, _AVX2, _FMA or _AVX512. */
-int mpmc_sim_get_kernels(const mpmc_sim sim, int *kernels) {
+int mpmc_sim_get_kernels(mpmc_const_sim sim, mpmc_kernels *kernels) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(kernels, sim->ctx, MPMC_ERR_ARG, "kernels pointer is NULL");
   *kernels = sim->cfg.kernels;

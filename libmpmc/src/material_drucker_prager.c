@@ -42,8 +42,8 @@ const mpmc_model mpmc_model_drucker_prager = {
  */
 int mpmc_sim_add_material_drucker_prager(mpmc_sim sim, double E, double nu, double rho, double c,
                                          double phi, double psi, double c_r, double phi_r,
-                                         double psi_r, double eta, double sigma_t, int match,
-                                         int *id) {
-  const double par[] = {E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t, match, NAN};
+                                         double psi_r, double eta, double sigma_t,
+                                         mpmc_dp_match match, int *id) {
+  const double par[] = {E, nu, rho, c, phi, psi, c_r, phi_r, psi_r, eta, sigma_t, (double)match, NAN};
   return mpmc_material_add(sim, &mpmc_model_drucker_prager, par, id);
 }

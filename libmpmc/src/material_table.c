@@ -199,7 +199,7 @@ int mpmc_model_get_param(int model, int k, mpmc_param_info *info) {
 }
 
 /** @brief Number of materials added so far. */
-int mpmc_sim_get_num_materials(const mpmc_sim sim, int *n) {
+int mpmc_sim_get_num_materials(mpmc_const_sim sim, int *n) {
   if (!sim || !n) return MPMC_ERR_ARG;
   *n = sim->nmat;
   return MPMC_SUCCESS;
@@ -210,7 +210,7 @@ int mpmc_sim_get_num_materials(const mpmc_sim sim, int *n) {
  *        strength reduction factor applied to it.
  * @param[out] par the model's nstore parameters (may be NULL); room for MPMC_MAX_PARAMS
  */
-int mpmc_sim_get_material(const mpmc_sim sim, int material, int *model, double *par,
+int mpmc_sim_get_material(mpmc_const_sim sim, int material, int *model, double *par,
                           double *factor) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(material >= 0 && material < sim->nmat, sim->ctx, MPMC_ERR_ARG,

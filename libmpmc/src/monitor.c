@@ -33,7 +33,7 @@
 #define MPMC_MONITOR_EVERY 8
 
 /* The inputs that may add energy.  Loads also enter through sum |f| (check passes only). */
-static void signature(const mpmc_sim sim, double *sig) {
+static void signature(mpmc_const_sim sim, double *sig) {
   for (int a = 0; a < 3; ++a) sig[a] = sim->cfg.gravity[a];
   double k = sim->nmat;
   for (int m = 0; m < sim->nmat; ++m) k += sim->mats[m].srm; /* strength reductions */
@@ -65,7 +65,7 @@ typedef struct {
   int bad_here;  /* over MPI: 1 on the rank of the failing point the message names        */
 } sums;
 
-static sums pass(const mpmc_sim sim, int with_psi) {
+static sums pass(mpmc_const_sim sim, int with_psi) {
   const mpmc_particles *p = &sim->p;
   const mpmc_material *mats = sim->mats;
   const double *g = sim->cfg.gravity, *f = p->force;

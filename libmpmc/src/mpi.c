@@ -51,7 +51,7 @@
 
 #ifndef MPMC_HAVE_MPI
 
-int mpmc_dd_agree(struct mpmc_sim_s *sim, int err) { return (void)sim, err < 0 ? MPMC_SUCCESS : err; }
+int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err) { return (void)sim, err < 0 ? MPMC_SUCCESS : err; }
 int mpmc_dd_halo(struct mpmc_sim_s *sim, int what) { return (void)sim, (void)what, MPMC_SUCCESS; }
 int mpmc_dd_migrate(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
 int mpmc_dd_balance_due(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
@@ -139,7 +139,7 @@ int mpmc_sim_create_mpi_f(mpmc_context ctx, MPI_Fint comm, int dim, mpmc_sim *si
 }
 
 /** @brief This rank's place in the decomposition (mpmc_mpi.h); NULL arguments are skipped. */
-int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis, int *cell_lo,
+int mpmc_sim_get_mpi_slab(mpmc_const_sim sim, int *rank, int *nranks, int *axis, int *cell_lo,
                           int *cell_hi) {
   if (!sim) return MPMC_ERR_ARG;
   const struct mpmc_dd_s *dd = sim->dd;
@@ -154,7 +154,7 @@ int mpmc_sim_get_mpi_slab(const mpmc_sim sim, int *rank, int *nranks, int *axis,
 }
 
 /** @brief Bytes and messages this rank sent since creation (mpmc_mpi.h); NULL: skipped. */
-int mpmc_sim_get_mpi_traffic(const mpmc_sim sim, double *halo_bytes, long *halo_msgs,
+int mpmc_sim_get_mpi_traffic(mpmc_const_sim sim, double *halo_bytes, long *halo_msgs,
                              double *migrated_bytes, long *migrate_msgs) {
   if (!sim) return MPMC_ERR_ARG;
   const struct mpmc_dd_s *dd = sim->dd;
@@ -239,7 +239,7 @@ int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) {
 
 /* ---- agreement and reductions --------------------------------------------------------- */
 
-int mpmc_dd_agree(struct mpmc_sim_s *sim, int err) {
+int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err) {
   struct mpmc_dd_s *dd = sim->dd;
   if (!dd) return err < 0 ? MPMC_SUCCESS : err;
   /* a real failure first, then a follower's (MPMC_DD_FOLLOW: a rank that knows the run
@@ -864,7 +864,7 @@ static double imbalance(const struct mpmc_sim_s *sim) {
 }
 
 /** @brief The most points on a rank over the mean over the ranks (collective; mpmc_mpi.h). */
-int mpmc_sim_get_mpi_imbalance(const mpmc_sim sim, double *value, long *balances) {
+int mpmc_sim_get_mpi_imbalance(mpmc_const_sim sim, double *value, long *balances) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(sim->dd, sim->ctx, MPMC_ERR_STATE, "not a simulation of mpmc_sim_create_mpi");
   if (value) *value = imbalance(sim);

@@ -647,7 +647,7 @@ enum { MPMC_DD_NODES = 0, MPMC_DD_FBAR = 1 }; /* what mpmc_dd_halo exchanges    
 int mpmc_dd_setup(struct mpmc_sim_s *sim);
 int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x);
 /* collective: the same error code and message on every rank (MPMC_DD_FOLLOW: see above) */
-int mpmc_dd_agree(struct mpmc_sim_s *sim, int err);
+int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err);
 int mpmc_dd_halo(struct mpmc_sim_s *sim, int what);
 int mpmc_dd_migrate(struct mpmc_sim_s *sim);
 /* before a step: move the cuts and the points if a balance is due (collective) */

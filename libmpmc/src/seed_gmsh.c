@@ -830,7 +830,7 @@ static int list_groups(session *s, pgroup **out, size_t *n) {
  * tributary square/cube that touches it), physical points the nearest new point and node.
  * On failure the sim is left as it was (no points, no sets added).
  */
-int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, int mode, int ppc,
+int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, mpmc_seed_mode mode, int ppc,
                    int material, int *first, int *count) {
   if (!sim) return MPMC_ERR_ARG;
   mpmc_context ctx = sim->ctx;

@@ -118,7 +118,7 @@ int mpmc_sim_add_particle_set(mpmc_sim sim, const char *name, int n, const int *
 }
 
 /** @brief Number of particle sets. */
-int mpmc_sim_get_num_particle_sets(const mpmc_sim sim, int *n) {
+int mpmc_sim_get_num_particle_sets(mpmc_const_sim sim, int *n) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(n, sim->ctx, MPMC_ERR_ARG, "output pointer n is NULL");
   *n = sim->sets ? sim->sets->n : 0;
@@ -129,14 +129,14 @@ int mpmc_sim_get_num_particle_sets(const mpmc_sim sim, int *n) {
  * @brief Borrow set `id`: its name, size and indices (valid until the sets change).
  * Any of name, n, idx may be NULL.
  */
-int mpmc_sim_get_particle_set(const mpmc_sim sim, int id, const char **name, int *n,
+int mpmc_sim_get_particle_set(mpmc_const_sim sim, int id, const char **name, int *n,
                               const int **idx) {
   if (!sim) return MPMC_ERR_ARG;
   return store_get(sim->ctx, sim->sets, "particle set", id, name, n, idx);
 }
 
 /** @brief The id of the set called `name`; MPMC_ERR_ARG if there is none. */
-int mpmc_sim_find_particle_set(const mpmc_sim sim, const char *name, int *id) {
+int mpmc_sim_find_particle_set(mpmc_const_sim sim, const char *name, int *id) {
   if (!sim) return MPMC_ERR_ARG;
   return store_find(sim->ctx, sim->sets, "particle set", name, id);
 }
@@ -168,7 +168,7 @@ int mpmc_sim_add_node_set(mpmc_sim sim, const char *name, int n, const int *ijk,
 }
 
 /** @brief Number of node sets. */
-int mpmc_sim_get_num_node_sets(const mpmc_sim sim, int *n) {
+int mpmc_sim_get_num_node_sets(mpmc_const_sim sim, int *n) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(n, sim->ctx, MPMC_ERR_ARG, "output pointer n is NULL");
   *n = sim->node_sets ? sim->node_sets->n : 0;
@@ -176,13 +176,13 @@ int mpmc_sim_get_num_node_sets(const mpmc_sim sim, int *n) {
 }
 
 /** @brief Borrow node set `id`: name, size and node coordinates ijk[n*dim]. */
-int mpmc_sim_get_node_set(const mpmc_sim sim, int id, const char **name, int *n, const int **ijk) {
+int mpmc_sim_get_node_set(mpmc_const_sim sim, int id, const char **name, int *n, const int **ijk) {
   if (!sim) return MPMC_ERR_ARG;
   return store_get(sim->ctx, sim->node_sets, "node set", id, name, n, ijk);
 }
 
 /** @brief The id of the node set called `name`; MPMC_ERR_ARG if there is none. */
-int mpmc_sim_find_node_set(const mpmc_sim sim, const char *name, int *id) {
+int mpmc_sim_find_node_set(mpmc_const_sim sim, const char *name, int *id) {
   if (!sim) return MPMC_ERR_ARG;
   return store_find(sim->ctx, sim->node_sets, "node set", name, id);
 }

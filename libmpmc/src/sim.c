@@ -62,13 +62,13 @@ int mpmc_sim_destroy(mpmc_sim *sim) {
   return MPMC_SUCCESS;
 }
 
-int mpmc_sim_get_context(const mpmc_sim sim, mpmc_context *ctx) {
+int mpmc_sim_get_context(mpmc_const_sim sim, mpmc_context *ctx) {
   if (!sim || !ctx) return MPMC_ERR_ARG;
   *ctx = sim->ctx;
   return MPMC_SUCCESS;
 }
 
-int mpmc_sim_get_dim(const mpmc_sim sim, int *dim) {
+int mpmc_sim_get_dim(mpmc_const_sim sim, int *dim) {
   if (!sim || !dim) return MPMC_ERR_ARG;
   *dim = sim->cfg.dim;
   return MPMC_SUCCESS;
@@ -94,7 +94,7 @@ int mpmc_sim_set_grid(mpmc_sim sim, const double *lo, const double *hi, double h
 }
 
 /** @brief The grid box and cell size (as rounded to whole cells). */
-int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h) {
+int mpmc_sim_get_grid(mpmc_const_sim sim, double *lo, double *hi, double *h) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(sim->grid.valid, sim->ctx, MPMC_ERR_STATE, "no grid set");
   for (int a = 0; a < sim->cfg.dim; ++a) {
@@ -106,7 +106,7 @@ int mpmc_sim_get_grid(const mpmc_sim sim, double *lo, double *hi, double *h) {
 }
 
 /** @brief Choose the basis (mpmc_basis). uGIMP needs each point's volume at its addition. */
-int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
+int mpmc_sim_set_basis(mpmc_sim sim, mpmc_basis basis) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(basis >= MPMC_BASIS_LINEAR && basis <= MPMC_BASIS_BSPLINE3, sim->ctx, MPMC_ERR_ARG,
              "basis = %d is not one of linear (0), ugimp (1), bspline2 (2), bspline3 (3)", basis);
@@ -122,7 +122,7 @@ int mpmc_sim_set_basis(mpmc_sim sim, int basis) {
  * scenes' default: Algorithm 1 where the points change volume or move, still where they rest;
  * docs/theory.md).
  */
-int mpmc_sim_set_fbar(mpmc_sim sim, int mode) {
+int mpmc_sim_set_fbar(mpmc_sim sim, mpmc_fbar_mode mode) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(mode >= MPMC_FBAR_OFF && mode <= MPMC_FBAR_ANCHORED, sim->ctx, MPMC_ERR_ARG,
              "fbar = %d is not one of off (0), paper (1), total (2), stable (3), anchored (4)",
@@ -132,9 +132,9 @@ int mpmc_sim_set_fbar(mpmc_sim sim, int mode) {
   return MPMC_SUCCESS;
 }
 
-int mpmc_sim_get_fbar(const mpmc_sim sim, int *enabled) {
-  if (!sim || !enabled) return MPMC_ERR_ARG;
-  *enabled = sim->cfg.fbar;
+int mpmc_sim_get_fbar(mpmc_const_sim sim, mpmc_fbar_mode *mode) {
+  if (!sim || !mode) return MPMC_ERR_ARG;
+  *mode = (mpmc_fbar_mode)sim->cfg.fbar;
   return MPMC_SUCCESS;
 }
 
@@ -207,7 +207,7 @@ int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta) {
  * @brief The adaptive damping's coefficient c = 2 zeta omega [1/s] the next step applies (0 when
  *        it is off or has no estimate yet).
  */
-int mpmc_sim_get_adaptive_damping(const mpmc_sim sim, double *c) {
+int mpmc_sim_get_adaptive_damping(mpmc_const_sim sim, double *c) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(c, sim->ctx, MPMC_ERR_ARG, "c is NULL");
   *c = sim->cfg.adr ? sim->adr_c : 0.0;
@@ -215,7 +215,7 @@ int mpmc_sim_get_adaptive_damping(const mpmc_sim sim, double *c) {
 }
 
 /** @brief Local solver for plastic return mapping (mpmc_solver). */
-int mpmc_sim_set_solver(mpmc_sim sim, int solver) {
+int mpmc_sim_set_solver(mpmc_sim sim, mpmc_solver solver) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(solver >= MPMC_SOLVER_AUTO && solver <= MPMC_SOLVER_KINSOL, sim->ctx, MPMC_ERR_ARG,
              "solver = %d is not one of auto (0), newton (1), kinsol (2)", solver);
@@ -327,7 +327,7 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
   return MPMC_SUCCESS;
 }
 
-int mpmc_sim_get_num_particles(const mpmc_sim sim, int *n) {
+int mpmc_sim_get_num_particles(mpmc_const_sim sim, int *n) {
   if (!sim || !n) return MPMC_ERR_ARG;
   *n = sim->p.n;
   return MPMC_SUCCESS;
@@ -410,7 +410,7 @@ static const char *field_names[MPMC_FIELD_COUNT] = {
  * a field the scene does not have is MPMC_ERR_STATE.  A borrowed velocity may be written:
  * until it is given back (mpmc_sim_restore_field) the stability limit recomputes max |v|.
  */
-int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
+int mpmc_sim_get_field(mpmc_sim sim, mpmc_field field, double **data, int *ncomp) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(data, sim->ctx, MPMC_ERR_ARG, "data pointer is NULL");
   int nc = 0;
@@ -425,7 +425,7 @@ int mpmc_sim_get_field(mpmc_sim sim, int field, double **data, int *ncomp) {
 }
 
 /** @brief Give back a field borrowed with mpmc_sim_get_field; sets *data to NULL. */
-int mpmc_sim_restore_field(mpmc_sim sim, int field, double **data) {
+int mpmc_sim_restore_field(mpmc_sim sim, mpmc_field field, double **data) {
   if (!sim) return MPMC_ERR_ARG;
   MPMC_CHECK(field >= 0 && field < MPMC_FIELD_COUNT, sim->ctx, MPMC_ERR_ARG,
              "field = %d is not a particle field", field);
@@ -460,7 +460,7 @@ int mpmc_sim_set_particle_forces(mpmc_sim sim, int first, int n, const double *f
   return MPMC_SUCCESS;
 }
 
-int mpmc_sim_get_time(const mpmc_sim sim, double *t) {
+int mpmc_sim_get_time(mpmc_const_sim sim, double *t) {
   if (!sim || !t) return MPMC_ERR_ARG;
   *t = sim->time;
   return MPMC_SUCCESS;
@@ -474,7 +474,7 @@ int mpmc_sim_set_time(mpmc_sim sim, double t) {
 }
 
 /** @brief Total kinetic energy 1/2 sum m |v|^2 of the material points. */
-int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke) {
+int mpmc_sim_get_kinetic_energy(mpmc_const_sim sim, double *ke) {
   if (!sim || !ke) return MPMC_ERR_ARG;
   const mpmc_particles *p = &sim->p;
   const int d = sim->cfg.dim;
@@ -490,7 +490,7 @@ int mpmc_sim_get_kinetic_energy(const mpmc_sim sim, double *ke) {
   return MPMC_SUCCESS;
 }
 
-int mpmc_sim_get_stats(const mpmc_sim sim, mpmc_stats *stats) {
+int mpmc_sim_get_stats(mpmc_const_sim sim, mpmc_stats *stats) {
   if (!sim || !stats) return MPMC_ERR_ARG;
   *stats = sim->stats;
   stats->time = sim->time;

@@ -63,7 +63,7 @@ static void permute_ints(int *a, const int *perm, int n, double *tmp) {
  * The halves order the points of a cell alike in every cell, so the kernels' branches (the
  * B-spline stencil starts at the cell below or at the cell itself, uGIMP's four cases) repeat
  * from cell to cell and predict well. */
-static int point_keys(const mpmc_sim sim, double *key, double *half, int *clo, int *chi) {
+static int point_keys(mpmc_const_sim sim, double *key, double *half, int *clo, int *chi) {
   const mpmc_grid *g = &sim->grid;
   const mpmc_particles *p = &sim->p;
   const int d = sim->cfg.dim, n = p->n;
@@ -216,7 +216,7 @@ int mpmc_sim_set_sort_interval(mpmc_sim sim, int nsteps) {
   return MPMC_SUCCESS;
 }
 
-int mpmc_sim_get_sort_interval(const mpmc_sim sim, int *nsteps) {
+int mpmc_sim_get_sort_interval(mpmc_const_sim sim, int *nsteps) {
   if (!sim || !nsteps) return MPMC_ERR_ARG;
   *nsteps = sim->cfg.sort_every;
   return MPMC_SUCCESS;

@@ -21,7 +21,7 @@ const char *mpmc_solver_name(int solver) {
 /**
  * @brief The name of a step phase (mpmc_phase), a static string.
  */
-const char *mpmc_phase_name(int phase) {
+const char *mpmc_phase_name(mpmc_phase phase) {
   static const char *const names[MPMC_PHASE_COUNT] = {"sort", "slabs", "p2g",    "grid",
                                                       "g2p",  "fbar",  "stress", "checks"};
   return phase >= 0 && phase < MPMC_PHASE_COUNT ? names[phase] : "unknown phase";
