@@ -59,9 +59,8 @@ static inline double mpmc_det3(double A[3][3]) {
    (s)[5] * ((s)[5] * (s)[2] - (s)[3] * (s)[4]) + (s)[4] * ((s)[5] * (s)[3] - (s)[1] * (s)[4]))
 static inline double mpmc_det_sym(const double *s) { return MPMC_DET_SYM(s); }
 
-/* Eigen-decomposition of a symmetric 3x3 tensor (Voigt s): s = sum_a lam[a] q_a q_a^T with
- * q_a the column a of Q.  Cyclic Jacobi; converges quadratically, ~3-5 sweeps. */
-static inline void mpmc_sym3_eig(const double *s, double lam[3], double Q[3][3]) {
+/* mpmc_sym3_eig's Jacobi sweeps, for entries whose squares neither overflow nor underflow */
+static inline void mpmc_sym3_jacobi(const double *s, double lam[3], double Q[3][3]) {
   double A[3][3];
   mpmc_voigt_to_mat(s, A);
   for (int i = 0; i < 3; ++i)
@@ -96,6 +95,27 @@ static inline void mpmc_sym3_eig(const double *s, double lam[3], double Q[3][3])
     }
   }
   for (int a = 0; a < 3; ++a) lam[a] = A[a][a];
+}
+
+/* Eigen-decomposition of a symmetric 3x3 tensor (Voigt s): s = sum_a lam[a] q_a q_a^T with
+ * q_a the column a of Q.  Cyclic Jacobi; converges quadratically, ~3-5 sweeps.  Its
+ * convergence test squares the entries: beyond 2^500 (3e150) they would overflow to inf and
+ * the sweeps stop at once with the diagonal as the eigenvalues, below 2^-500 underflow to 0.
+ * There the tensor is scaled by a power of two first, which is exact, and the eigenvalues
+ * back: the same bits as the unscaled sweeps would give without overflow. */
+static inline void mpmc_sym3_eig(const double *s, double lam[3], double Q[3][3]) {
+  double m = 0.0;
+  for (int k = 0; k < 6; ++k) m = fmax(m, fabs(s[k]));
+  if (!(m > 0x1p500 || (m < 0x1p-500 && m > 0.0)) || !isfinite(m)) {
+    mpmc_sym3_jacobi(s, lam, Q);
+    return;
+  }
+  int e;
+  (void)frexp(m, &e);
+  double t[6];
+  for (int k = 0; k < 6; ++k) t[k] = ldexp(s[k], -e);
+  mpmc_sym3_jacobi(t, lam, Q);
+  for (int a = 0; a < 3; ++a) lam[a] = ldexp(lam[a], e);
 }
 
 /* The cross products x[k] of the rows (0,1), (0,2), (1,2) of C (3x3) and their squared
