@@ -48,15 +48,7 @@ void mpmc_damping_apply(double alpha, double *restrict f, const double *restrict
 void mpmc_kinetic_damping(struct mpmc_sim_s *sim) {
   mpmc_particles *p = &sim->p;
   const int d = sim->cfg.dim;
-  double e = 0.0;
-#pragma omp parallel for reduction(+ : e) schedule(static) if (p->n > MPMC_OMP_MIN)
-  for (int q = 0; q < p->n; ++q) {
-    double v2 = 0.0;
-    for (int a = 0; a < d; ++a) v2 += p->v[(size_t)q * d + a] * p->v[(size_t)q * d + a];
-    e += p->m[q] * v2;
-  }
-  mpmc_dd_sum(sim, &e, 1); /* MPI: over the ranks, the same bits on each */
-  e *= 0.5;
+  double e = mpmc_points_kinetic_energy(sim); /* MPI: over the ranks, the same bits on each */
   if (sim->kd_ke >= 0.0 && e < sim->kd_ke) { /* past the peak */
     const size_t nv = (size_t)p->n * (size_t)d;
 #pragma omp parallel for schedule(static) if (p->n > MPMC_OMP_MIN)

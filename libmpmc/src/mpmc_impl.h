@@ -602,6 +602,8 @@ int mpmc_sort_due(struct mpmc_sim_s *sim);
 int mpmc_sim_prepare(struct mpmc_sim_s *sim);
 int mpmc_boundary_apply_flags(struct mpmc_sim_s *sim);
 void mpmc_damping_apply(double alpha, double *restrict f, const double *restrict v, int dim);
+/* 1/2 sum m |v|^2 of the points over all ranks (sim.c; collective) */
+double mpmc_points_kinetic_energy(const struct mpmc_sim_s *sim);
 /* Kinetic damping after G2P: at a peak of the points' E_k, every point velocity to zero. */
 void mpmc_kinetic_damping(struct mpmc_sim_s *sim);
 /* Adaptive damping: the node store for the step's grid update (0, or MPMC_ERR_MEMORY), and
