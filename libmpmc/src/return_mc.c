@@ -871,6 +871,7 @@ static int tension_regions(const mpmc_mc_param *m, const mc_mat *q0) {
   return !(2.0 * eta < 1.7320508075688772 * (1.0 - 1e-6));
 }
 
+#if !defined(MPMC_ISA_AVX2)
 /* the material is one mpmc_mc_return_principal accepts */
 static int param_ok(const mpmc_mc_param *m) {
   return m->K > 0 && m->G > 0 && m->c_r >= 0 && m->c_p >= m->c_r && m->eta >= 0 &&
@@ -890,22 +891,28 @@ void mpmc_mc_soften(const mpmc_mc_param *m, double eps_p, double *c, double *phi
   if (phi) *phi = m->phi_r + (m->phi_p - m->phi_r) * e;
   if (psi) *psi = m->psi_r + (m->psi_p - m->psi_r) * e;
 }
+#endif
+
 
 /**
  * @brief The tolerance on the yield functions [Pa] for a trial stress: 1e-12 of the largest
  * of |tau_trial|, c_p and a finite sigma_t (the round-off of the returned stress is ~1e-16
  * of |tau_trial|).
  */
-double mpmc_mc_tolerance(const mpmc_mc_param *m, const double t[3]) {
+static inline double tolerance(const mpmc_mc_param *m, const double t[3]) {
   double s = max_nn(max_nn(fabs(t[0]), fabs(t[1])), max_nn(fabs(t[2]), m->c_p));
   if (isfinite(m->sigma_t)) s = max_nn(s, fabs(m->sigma_t));
   return 1e-12 * s + DBL_MIN;
 }
+#if !defined(MPMC_ISA_AVX2)
+double mpmc_mc_tolerance(const mpmc_mc_param *m, const double t[3]) { return tolerance(m, t); }
+#endif
 
 static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double eps_tr[3],
                      double *eps_p, double eps[3], double tau[3], mpmc_mc_info *info,
                      const mc_mat *q0in);
 
+#if !defined(MPMC_ISA_AVX2)
 /**
  * @brief Frictional return map of one point in principal space (return_mc.h).
  * @param ws      per-thread workspace (KINSOL's memory; may be NULL for MPMC_SOLVER_NEWTON
@@ -931,6 +938,7 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
   if (!param_ok(m)) return MPMC_ERR_ARG;
   return principal(ws, solver, m, eps_tr, eps_p, eps, tau, info, NULL);
 }
+#endif
 
 /* mpmc_mc_return_principal for a material that passed param_ok, info zeroed; q0in: the
  * material at *eps_p when the caller has it (mpmc_mc_update), else NULL. */
@@ -958,7 +966,7 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
   S.e_frozen = 0.0;
   for (int k = 0; k < 3; ++k) S.str[k] = m->K * tr + 2.0 * m->G * (eps_tr[perm[k]] - tr / 3.0);
   if (!(isfinite(S.str[0]) && isfinite(S.str[2]))) return MPMC_ERR_NUMERIC;
-  S.tolf = mpmc_mc_tolerance(m, S.str);
+  S.tolf = tolerance(m, S.str);
   S.yscale = max_nn(fabs(S.str[0]), fabs(S.str[2])) / m->G + 1e-300;
   S.e0 = q0in ? q0in->e : e_of(m, S.ep0);
   if (q0in)
@@ -1151,6 +1159,7 @@ static int return_decomposed(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
   return MPMC_SUCCESS;
 }
 
+#if !defined(MPMC_ISA_AVX2)
 /**
  * @brief The frictional return map of one point in tensor form by the eigen-decomposition
  * of the trial b_e for every point (return_mc.h; the principal directions are kept).
@@ -1213,8 +1222,47 @@ static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, d
   *lg = 1;
   return elastic_check(pre, b, eps_out, eps_p, be, tau, J_out, qout);
 }
+#endif
 
-/* elastic_fast's check from the series strain eps of b (mpmc_mc_update4's lanes too) */
+/* elastic_check's material at eps_p: *qout for the return, and what the check needs of it,
+ * c = (sin phi, k, eta_f, sqrt(1 + sin^2(phi) / 3), the capped cut-off) */
+static inline void check_mat(const mpmc_mc_pre *pre, double eps_p, mc_mat *qout, double c[5]) {
+  const mpmc_mc_param *m = &pre->m;
+  c[0] = pre->sf, c[1] = pre->k, c[2] = pre->eta, c[3] = pre->gmax, c[4] = pre->st;
+  *qout = pre->q0;
+  if (pre->perfect && eps_p != 0.0 && m->eta > 0.0) qout->e = e_of(m, eps_p);
+  if (!(pre->perfect || eps_p == 0.0)) {
+    mc_mat q;
+    /* the sines and cosines from those of the nearest of pre's materials (sin_cos_near) */
+    const double ee = e_of(m, eps_p);
+    const int kr = (int)(ee * (MPMC_MC_NREF - 1) + 0.5);
+    mat_eval(m, ee, 1, &q, &pre->ref[kr < 0 ? 0 : kr > MPMC_MC_NREF - 1 ? MPMC_MC_NREF - 1 : kr]);
+    *qout = q;
+    c[0] = q.sf;
+    c[1] = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
+    c[2] = q.eta;
+    c[3] = sqrt(1.0 + c[0] * c[0] / 3.0);
+    c[4] = q.st;
+  }
+}
+
+/* elastic_check's decision by the principal stresses from the invariants of the deviator s
+ * (J2 = j2, sqrt(J2) = rj), where its bounds left ok_f or ok_t open: 1 elastic */
+static int check_trig(const double s[6], double j2, double rj, double p, double sf, double k,
+                      double st, double margin, int ok_f, int ok_t) {
+  const double r3 = 1.7320508075688772;
+  /* the largest and smallest principal deviatoric stresses from the invariants */
+  const double x = j2 > 0.0 ? 1.5 * r3 * mpmc_det_sym(s) / (j2 * rj) : 1.0;
+  const double a = acos(!(x > -1.0) ? -1.0 : x >= 1.0 ? 1.0 : x) / 3.0, ca = cos(a), sa = sin(a);
+  const double R = 2.0 * rj / r3, s1 = R * ca, s3 = R * (-0.5 * ca - 0.5 * r3 * sa);
+  if (!ok_f) ok_f = (s1 - s3) + (2.0 * p + s1 + s3) * sf - k < -margin;
+  if (!ok_t) ok_t = p + s1 < st - margin;
+  return ok_f && ok_t;
+}
+
+#if !defined(MPMC_ISA_AVX2)
+/* elastic_fast's check from the series strain eps of b (mpmc_mc_update4 takes its steps
+ * four lanes at a time) */
 static int elastic_check(const mpmc_mc_pre *pre, const double *b, const double *eps,
                          double eps_p, double *be, double *tau, double *J_out, mc_mat *qout) {
   const mpmc_mc_param *m = &pre->m;
@@ -1225,22 +1273,9 @@ static int elastic_check(const mpmc_mc_pre *pre, const double *b, const double *
   double s[6];
   for (int k = 0; k < 6; ++k) s[k] = G2 * e[k];
   const double j2 = 0.5 * mpmc_sym3_norm2(s), rj = sqrt(j2);
-  double sf = pre->sf, k = pre->k, eta = pre->eta, gmax = pre->gmax, st = pre->st;
-  *qout = pre->q0;
-  if (pre->perfect && eps_p != 0.0 && m->eta > 0.0) qout->e = e_of(m, eps_p);
-  if (!(pre->perfect || eps_p == 0.0)) {
-    mc_mat q;
-    /* the sines and cosines from those of the nearest of pre's materials (sin_cos_near) */
-    const double ee = e_of(m, eps_p);
-    const int kr = (int)(ee * (MPMC_MC_NREF - 1) + 0.5);
-    mat_eval(m, ee, 1, &q, &pre->ref[kr < 0 ? 0 : kr > MPMC_MC_NREF - 1 ? MPMC_MC_NREF - 1 : kr]);
-    *qout = q;
-    sf = q.sf;
-    k = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
-    eta = q.eta;
-    gmax = sqrt(1.0 + sf * sf / 3.0);
-    st = q.st;
-  }
+  double c[5];
+  check_mat(pre, eps_p, qout, c);
+  const double sf = c[0], k = c[1], eta = c[2], gmax = c[3], st = c[4];
   const double margin = 1e-6 * (fabs(p) + rj + k);
   const int mc = m->surface == MPMC_MC_MOHR_COULOMB;
   const double r3 = 1.7320508075688772;
@@ -1250,21 +1285,14 @@ static int elastic_check(const mpmc_mc_pre *pre, const double *b, const double *
    * s1 = s2): beyond the surface by the margin with that, the point is plastic */
   if (mc && !ok_f && rj * (r3 - sf / r3) + 2.0 * p * sf - k > margin) return 0;
   int ok_t = p + 2.0 * rj / r3 < st - margin;
-  if (!(ok_f && ok_t)) {
-    /* the largest and smallest principal deviatoric stresses from the invariants */
-    const double x = j2 > 0.0 ? 1.5 * r3 * mpmc_det_sym(s) / (j2 * rj) : 1.0;
-    const double a = acos(!(x > -1.0) ? -1.0 : x >= 1.0 ? 1.0 : x) / 3.0, ca = cos(a), sa = sin(a);
-    const double R = 2.0 * rj / r3, s1 = R * ca, s3 = R * (-0.5 * ca - 0.5 * r3 * sa);
-    if (!ok_f) ok_f = (s1 - s3) + (2.0 * p + s1 + s3) * sf - k < -margin;
-    if (!ok_t) ok_t = p + s1 < st - margin;
-    if (!(ok_f && ok_t)) return 0;
-  }
+  if (!(ok_f && ok_t) && !check_trig(s, j2, rj, p, sf, k, st, margin, ok_f, ok_t)) return 0;
   for (int i = 0; i < 6; ++i) be[i] = b[i]; /* elastic: keep b_e as pushed forward */
   for (int i = 0; i < 6; ++i) tau[i] = s[i];
   for (int i = 0; i < 3; ++i) tau[i] += p;
   if (J_out) *J_out = exp(tr);
   return 1;
 }
+#endif
 
 /* Drucker-Prager's plastic point without eigenvectors (as J2's, material_hencky_j2.c).  The
  * cone's return is radial in the deviator: its principal problem sees the trial stress only
@@ -1330,6 +1358,7 @@ static int dp_radial(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, const d
   return 0;
 }
 
+#if !defined(MPMC_ISA_AVX2)
 /**
  * @brief The frictional return map of one point in tensor form (return_mc.h): the elastic
  * check without eigenvectors (elastic_fast), the eigen path for the rest.
@@ -1355,20 +1384,23 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
   return return_eig(ws, solver, &pre->m, lg ? eps : b, lg ? b : NULL, be, eps_p, tau, J_out,
                     info, lg ? &q0 : NULL);
 }
+#endif
 
 /**
  * @brief mpmc_mc_update of four points at once (return_mc.h): lane l of the block is point
  * F[l], be[l], eps_p[l], tau[l], J_out[l], info[l], err[l] (its return value), l < n <= 4.
- * The push-forward, the series Hencky strain and the closed-form eigen-decomposition of the
- * points that need it run as batch4.h vectors, so the four points' latency chains (square
- * roots, divisions) overlap; the elastic check, the principal return and the recomposition
- * per point.  Every lane takes mpmc_mc_update's operations (the series at its own degree,
- * the decomposition's branches as masks), so each point gets its results to the bit but for
- * the sign of a zero (t414).
+ * The push-forward, the series Hencky strain, the elastic check's bounds, the closed-form
+ * eigen-decomposition and the recomposition of b_e and tau run as batch4.h vectors, so the
+ * four points' latency chains (square roots, divisions) overlap; the material at eps_p, the
+ * elastic check's principal stresses where its bounds decide nothing and the principal
+ * return per point.  Every lane takes mpmc_mc_update's operations (the series at its own
+ * degree, the branches as masks, libm per lane), so each point gets its results to the bit
+ * but for the sign of a zero (t414).  Also compiled for x86-64-v3 (mpmc_mc_update4_avx2,
+ * mpmc_mc_update4_for).
  */
-void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
-                     double F[][3][3], double be[][6], double *eps_p, double tau[][6],
-                     double *J_out, mpmc_mc_info *info, int *err) {
+void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
+                               double F[][3][3], double be[][6], double *eps_p, double tau[][6],
+                               double *J_out, mpmc_mc_info *info, int *err) {
   v4 Fv[9], bv[6], bt[6], eps[6];
   l4 sm = {0, 0, 0, 0}, sfail, eigm = {0, 0, 0, 0};
   for (int l = 0; l < 4; ++l) {
@@ -1385,24 +1417,92 @@ void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
   }
   push_forward4(Fv, bv, bt);
   sym_log_series4_lanes(bt, &sm, eps, &sfail);
+  /* elastic_check's steps four lanes at a time (lanes ck): the material per lane, the
+   * deviator, the bounds as vectors, the principal stresses from the invariants per lane
+   * where they decide nothing */
+  const int mc = pre->m.surface == MPMC_MC_MOHR_COULOMB;
+  const int ck = mask_bits(&sm) & ~mask_bits(&sfail);
   mc_mat q0[4];
+  int elastic = 0;
+  v4 sv[6], pv, trv;
+  if (ck) {
+    const mpmc_mc_param *m = &pre->m;
+    v4 c[5];
+    for (int l = 0; l < 4; ++l) {
+      double cl[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+      if (ck >> l & 1) check_mat(pre, eps_p[l], &q0[l], cl);
+      for (int i = 0; i < 5; ++i) c[i][l] = cl[i];
+    }
+    const v4 sf = c[0], k = c[1], eta = c[2], gmax = c[3], st = c[4];
+    const l4 ckm = mpmc_lane_mask[ck];
+    const v4 zero = {0.0, 0.0, 0.0, 0.0};
+    v4 e[6];
+    for (int i = 0; i < 6; ++i) e[i] = SEL4(ckm, eps[i], zero); /* others' are not formed */
+    trv = e[0] + e[1] + e[2];
+    const double G2 = 2.0 * m->G;
+    pv = m->K * trv;
+    for (int i = 0; i < 3; ++i) e[i] -= trv / 3.0;
+    for (int i = 0; i < 6; ++i) sv[i] = G2 * e[i];
+    v4 j2, rj;
+    norm2_4(sv, &j2);
+    j2 = 0.5 * j2;
+    sqrt4(&j2, &rj);
+    const v4 margin = 1e-6 * (ABS4(pv) + rj + k);
+    const double r3 = 1.7320508075688772;
+    int ok_f, ok_t, open = 0;
+    if (mc) {
+      ok_f = mask_bits(&CMP4(2.0 * rj * gmax + 2.0 * pv * sf - k, <, -margin));
+      /* plastic for sure by the lower bound */
+      const int pl = mask_bits(&CMP4(rj * (r3 - sf / r3) + 2.0 * pv * sf - k, >, margin));
+      open = ck & ~ok_f & ~pl;
+    } else
+      ok_f = mask_bits(&CMP4(rj + eta * pv - k, <, -margin));
+    ok_t = mask_bits(&CMP4(pv + 2.0 * rj / r3, <, st - margin));
+    elastic = ck & ok_f & ok_t;
+    /* the lanes the bounds leave open: those of ok_f with ok_t open (either model), and
+     * Mohr-Coulomb's between its bounds */
+    open = (open | (ck & ok_f)) & ~elastic;
+    for (int l = 0; l < 4; ++l) {
+      if (!(open >> l & 1)) continue;
+      const double sl[6] = {sv[0][l], sv[1][l], sv[2][l], sv[3][l], sv[4][l], sv[5][l]};
+      if (check_trig(sl, j2[l], rj[l], pv[l], sf[l], k[l], st[l], margin[l], ok_f >> l & 1,
+                     ok_t >> l & 1))
+        elastic |= 1 << l;
+    }
+  }
+  if (elastic) { /* b_e as pushed forward, tau = s + p I, J = exp(tr) */
+    v4 tv[6];
+    for (int i = 0; i < 6; ++i) tv[i] = i < 3 ? sv[i] + pv : sv[i];
+    if (elastic == 15 && n == 4) {
+      store_rows6(bt, be[0]);
+      store_rows6(tv, tau[0]);
+    } else
+      for (int l = 0; l < 4; ++l)
+        if (elastic >> l & 1)
+          for (int i = 0; i < 6; ++i) {
+            be[l][i] = bt[i][l];
+            tau[l][i] = tv[i][l];
+          }
+    for (int l = 0; l < 4; ++l)
+      if (elastic >> l & 1) {
+        J_out[l] = exp(trv[l]);
+        err[l] = MPMC_SUCCESS;
+        if (info) memset(&info[l], 0, sizeof info[l]);
+      }
+  }
   for (int l = 0; l < n; ++l) {
+    if (elastic >> l & 1) continue;
     double b[6], e[6];
     mpmc_mc_info *inf = info ? &info[l] : NULL;
     for (int k = 0; k < 6; ++k) b[k] = bt[k][l];
-    if (!sm[l] || sfail[l]) { /* beyond the series, or not for elastic_fast: the eigen path */
+    if (!(ck >> l & 1)) { /* beyond the series, or not for elastic_fast: the eigen path */
       err[l] = return_eig(ws, solver, &pre->m, b, NULL, be[l], &eps_p[l], tau[l], &J_out[l],
                           inf, NULL);
       continue;
     }
-    for (int k = 0; k < 6; ++k) e[k] = eps[k][l];
     err[l] = MPMC_SUCCESS;
-    if (elastic_check(pre, b, e, eps_p[l], be[l], tau[l], &J_out[l], &q0[l])) {
-      if (inf) memset(inf, 0, sizeof *inf);
-      continue;
-    }
-    if (pre->m.surface != MPMC_MC_MOHR_COULOMB &&
-        !dp_radial(ws, solver, pre, b, e, &q0[l], be[l], &eps_p[l], tau[l], &J_out[l], inf))
+    for (int k = 0; k < 6; ++k) e[k] = eps[k][l];
+    if (!mc && !dp_radial(ws, solver, pre, b, e, &q0[l], be[l], &eps_p[l], tau[l], &J_out[l], inf))
       continue;
     eigm[l] = -1;
   }
@@ -1410,24 +1510,96 @@ void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
   v4 lam[3], Q[9];
   l4 fb;
   sym3_eig_closed4(eps, &eigm, lam, Q, &fb);
+  /* the principal return per lane (return_decomposed's), its strains and stresses e, t */
+  const v4 zero = {0.0, 0.0, 0.0, 0.0};
+  v4 ev[3] = {zero, zero, zero}, tv[3] = {zero, zero, zero};
+  double epn[4];
+  int done = 0;
   for (int bits = mask_bits(&eigm), l = 0; bits; bits >>= 1, ++l) {
     if (!(bits & 1)) continue;
-    double b[6], lm[3], Ql[3][3];
-    for (int k = 0; k < 6; ++k) b[k] = bt[k][l];
     if (fb[l]) { /* a special case of the closed form: its scalar code */
-      double e[6];
+      double e[6], lm[3], Ql[3][3];
       for (int k = 0; k < 6; ++k) e[k] = eps[k][l];
       mpmc_sym3_eig_closed(e, lm, Ql);
-    } else
       for (int a = 0; a < 3; ++a) {
-        lm[a] = lam[a][l];
-        for (int i = 0; i < 3; ++i) Ql[i][a] = Q[3 * i + a][l];
+        lam[a][l] = lm[a];
+        for (int i = 0; i < 3; ++i) Q[3 * i + a][l] = Ql[i][a];
       }
-    err[l] = return_decomposed(ws, solver, &pre->m, lm, Ql, b, be[l], &eps_p[l], tau[l],
-                               &J_out[l], info ? &info[l] : NULL, &q0[l]);
+    }
+    const double etr[3] = {lam[0][l], lam[1][l], lam[2][l]};
+    double e[3], t[3];
+    mpmc_mc_info local, *inf = info ? &info[l] : &local;
+    memset(inf, 0, sizeof *inf);
+    epn[l] = eps_p[l];
+    err[l] = principal(ws, solver, &pre->m, etr, &epn[l], e, t, inf, &q0[l]);
+    if (err[l]) continue;
+    for (int a = 0; a < 3; ++a) {
+      ev[a][l] = e[a];
+      tv[a][l] = t[a];
+    }
+    done |= 1 << l;
+  }
+  if (!done) return;
+  /* return_decomposed's recomposition, its operations lane by lane: b_e's eigenvalues
+   * q_a.b q_a exp(2 (eps_a - eps_tr,a)) (libm's exp(2 eps_a) beyond the polynomial), b_e and
+   * tau from them and Q, J */
+  const l4 dm = mpmc_lane_mask[done];
+  v4 lb[3], bev[6], tauv[6], Jv;
+  for (int a = 0; a < 3; ++a) {
+    const v4 etr = SEL4(dm, lam[a], ev[a]); /* d = 0 in the other lanes */
+    const v4 d = 2.0 * (etr - ev[a]), ad = ABS4(d);
+    const v4 x = Q[a], y = Q[3 + a], z = Q[6 + a];
+    const v4 lt = x * (bt[0] * x + bt[5] * y + bt[4] * z) + y * (bt[5] * x + bt[1] * y + bt[3] * z) +
+                  z * (bt[4] * x + bt[3] * y + bt[2] * z);
+    lb[a] = lt * MPMC_RM_EXP_NEG_POLY(d);
+    const int big = done & ~mask_bits(&CMP4(ad, <=, ((v4){MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL,
+                                                          MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL})));
+    for (int l = 0; l < 4; ++l)
+      if (big >> l & 1) lb[a][l] = exp(2.0 * ev[a][l]);
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) {
+      const int k = mpmc_voigt(i, j);
+      bev[k] = lb[0] * Q[3 * i] * Q[3 * j] + lb[1] * Q[3 * i + 1] * Q[3 * j + 1] +
+               lb[2] * Q[3 * i + 2] * Q[3 * j + 2];
+      tauv[k] = tv[0] * Q[3 * i] * Q[3 * j] + tv[1] * Q[3 * i + 1] * Q[3 * j + 1] +
+                tv[2] * Q[3 * i + 2] * Q[3 * j + 2];
+    }
+  {
+    const v4 etr0 = SEL4(dm, lam[0], ev[0]), etr1 = SEL4(dm, lam[1], ev[1]),
+             etr2 = SEL4(dm, lam[2], ev[2]);
+    const v4 d = (etr0 + etr1 + etr2) - (ev[0] + ev[1] + ev[2]), ad = ABS4(d);
+    v4 det, sq;
+    det_sym4(bt, &det);
+    det = SEL4(dm, det, ((v4){1.0, 1.0, 1.0, 1.0}));
+    sqrt4(&det, &sq);
+    Jv = sq * MPMC_RM_EXP_NEG_POLY(d);
+    const int big = done & ~mask_bits(&CMP4(ad, <=, ((v4){MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL,
+                                                          MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL})));
+    for (int l = 0; l < 4; ++l)
+      if (big >> l & 1) Jv[l] = exp(ev[0][l] + ev[1][l] + ev[2][l]);
+  }
+  if (done == 15 && n == 4) {
+    store_rows6(bev, be[0]);
+    store_rows6(tauv, tau[0]);
+    for (int l = 0; l < 4; ++l) {
+      J_out[l] = Jv[l];
+      eps_p[l] = epn[l];
+    }
+    return;
+  }
+  for (int l = 0; l < 4; ++l) {
+    if (!(done >> l & 1)) continue;
+    for (int k = 0; k < 6; ++k) {
+      be[l][k] = bev[k][l];
+      tau[l][k] = tauv[k][l];
+    }
+    J_out[l] = Jv[l];
+    eps_p[l] = epn[l];
   }
 }
 
+#if !defined(MPMC_ISA_AVX2)
 /**
  * @brief The frictional return map of one point in tensor form (return_mc.h): mpmc_mc_update
  * with the material prepared here (for the tests; a material's update prepares it once).
@@ -1438,6 +1610,21 @@ int mpmc_mc_return_map(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, doubl
   mpmc_mc_pre pre;
   mpmc_mc_prepare(m, &pre);
   return mpmc_mc_update(ws, solver, &pre, F, be, eps_p, tau, J_out, info);
+}
+
+/**
+ * @brief The block update for a sim's kernel set (return_mc.h): mpmc_mc_update4 compiled for
+ * x86-64-v3 (AVX2, no contraction: the same bits) where the build carries it, the processor
+ * runs it and the set is not the baseline; else the baseline's.
+ */
+mpmc_mc_update4_fn mpmc_mc_update4_for(int kernels) {
+#if defined(MPMC_HAVE_AVX2_KERNELS)
+  if (kernels != MPMC_KERNELS_BASELINE && mpmc_kernels_avx2_available())
+    return mpmc_mc_update4_avx2;
+#else
+  (void)kernels;
+#endif
+  return mpmc_mc_update4;
 }
 
 /**
@@ -1453,3 +1640,4 @@ void mpmc_mc_reduce(mpmc_mc_param *m, double factor) {
   m->psi_p = atan(tan(m->psi_p) / factor);
   m->psi_r = atan(tan(m->psi_r) / factor);
 }
+#endif

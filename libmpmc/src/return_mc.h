@@ -154,6 +154,17 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
 void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
                      double F[][3][3], double be[][6], double *eps_p, double tau[][6],
                      double *J_out, mpmc_mc_info *info, int *err);
+/* The same compiled for x86-64-v3 (AVX2's 256-bit vectors; ISO C's -ffp-contract=off, so
+ * the same bits), in builds with the AVX2 kernels (MPMC_KERNEL_DISPATCH, CMakeLists.txt). */
+void mpmc_mc_update4_avx2(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
+                          double F[][3][3], double be[][6], double *eps_p, double tau[][6],
+                          double *J_out, mpmc_mc_info *info, int *err);
+typedef void (*mpmc_mc_update4_fn)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
+                                   double F[][3][3], double be[][6], double *eps_p,
+                                   double tau[][6], double *J_out, mpmc_mc_info *info, int *err);
+/* The block update a sim of kernel set kernels (MPMC_KERNELS_*) runs: the AVX2 one where
+ * the build has it, the processor runs it and kernels is not MPMC_KERNELS_BASELINE. */
+mpmc_mc_update4_fn mpmc_mc_update4_for(int kernels);
 
 void mpmc_mc_reduce(mpmc_mc_param *m, double factor);
 
