@@ -202,8 +202,9 @@ static inline double dot3(const double a[3], const double b[3]) {
 }
 
 /* A plane surface s: gradient a, flow N, their eps_p-derivatives, strength k (f = a.s - k) */
-static void plane(int s, const mc_mat *q, double a[3], double da[3], double N[3], double dN[3],
-                  double *k, double *dk) {
+static inline __attribute__((always_inline)) void plane(int s, const mc_mat *q, double a[3],
+                                                        double da[3], double N[3], double dN[3],
+                                                        double *k, double *dk) {
   for (int i = 0; i < 3; ++i) a[i] = da[i] = N[i] = dN[i] = 0.0;
   if (s <= S_C) {
     const int I = mc_ij[s][0], J = mc_ij[s][1];
@@ -940,16 +941,27 @@ int mpmc_mc_return_principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m,
 }
 #endif
 
-/* mpmc_mc_return_principal for a material that passed param_ok, info zeroed; q0in: the
- * material at *eps_p when the caller has it (mpmc_mc_update), else NULL. */
-static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double eps_tr[3],
-                     double *eps_p, double eps[3], double tau[3], mpmc_mc_info *info,
-                     const mc_mat *q0in) {
+/* principal's point between its set-up and its regions (mpmc_mc_update4 solves the first
+ * region of four points at once in between) */
+typedef struct {
+  mc_sys S;
+  int perm[3]; /* perm[k] = the input index of the k-th largest */
+  int perfect;
+} mc_point;
+
+/* principal's set-up: the sorted trial stress, the tolerances, the material at eps_p.
+ * Returns an error code, or 0 with *done = 1 when the point is elastic (eps, tau written), or
+ * 0 with *done = 0 and P set up (info->plastic = 1). */
+static int principal_begin(const mpmc_mc_param *m, const double eps_tr[3], const double *eps_p,
+                           double eps[3], double tau[3], mpmc_mc_info *info,
+                           const mc_mat *q0in, mc_point *P, int *done) {
+  *done = 0;
   if (!(isfinite(eps_tr[0]) && isfinite(eps_tr[1]) && isfinite(eps_tr[2]) && isfinite(*eps_p) &&
         *eps_p >= 0))
     return MPMC_ERR_NUMERIC;
   /* sort: perm[k] = the input index of the k-th largest */
-  int perm[3] = {0, 1, 2};
+  int *perm = P->perm;
+  perm[0] = 0, perm[1] = 1, perm[2] = 2;
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2 - i; ++j)
       if (eps_tr[perm[j]] < eps_tr[perm[j + 1]]) {
@@ -958,124 +970,132 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
         perm[j + 1] = t;
       }
   const double tr = eps_tr[0] + eps_tr[1] + eps_tr[2];
-  mc_sys S; /* not zeroed as a whole: ~0.5 kB, a tenth of a fast return */
-  S.m = m;
-  S.dp = m->surface != MPMC_MC_MOHR_COULOMB;
-  S.n = S.act[0] = S.act[1] = S.act[2] = S.frozen = 0;
-  S.ep0 = *eps_p;
-  S.e_frozen = 0.0;
-  for (int k = 0; k < 3; ++k) S.str[k] = m->K * tr + 2.0 * m->G * (eps_tr[perm[k]] - tr / 3.0);
-  if (!(isfinite(S.str[0]) && isfinite(S.str[2]))) return MPMC_ERR_NUMERIC;
-  S.tolf = tolerance(m, S.str);
-  S.yscale = max_nn(fabs(S.str[0]), fabs(S.str[2])) / m->G + 1e-300;
-  S.e0 = q0in ? q0in->e : e_of(m, S.ep0);
+  mc_sys *const S = &P->S; /* not zeroed as a whole: ~0.5 kB, a tenth of a fast return */
+  S->m = m;
+  S->dp = m->surface != MPMC_MC_MOHR_COULOMB;
+  S->n = S->act[0] = S->act[1] = S->act[2] = S->frozen = 0;
+  S->ep0 = *eps_p;
+  S->e_frozen = 0.0;
+  for (int k = 0; k < 3; ++k) S->str[k] = m->K * tr + 2.0 * m->G * (eps_tr[perm[k]] - tr / 3.0);
+  if (!(isfinite(S->str[0]) && isfinite(S->str[2]))) return MPMC_ERR_NUMERIC;
+  S->tolf = tolerance(m, S->str);
+  S->yscale = max_nn(fabs(S->str[0]), fabs(S->str[2])) / m->G + 1e-300;
+  S->e0 = q0in ? q0in->e : e_of(m, S->ep0);
   if (q0in)
-    S.q0 = *q0in;
+    S->q0 = *q0in;
   else
-    mat_eval(m, S.e0, 1, &S.q0, NULL);
-  const mc_mat q0 = S.q0;
-  const double f0 = S.dp ? dp_f(&q0, S.str) : mc_f(&q0, S.str, 0, 2);
-  double s[3], ep_new = S.ep0;
-  if (f0 <= S.tolf && S.str[0] <= q0.st + S.tolf) { /* elastic */
+    mat_eval(m, S->e0, 1, &S->q0, NULL);
+  const mc_mat *q0 = &S->q0;
+  const double f0 = S->dp ? dp_f(q0, S->str) : mc_f(q0, S->str, 0, 2);
+  if (f0 <= S->tolf && S->str[0] <= q0->st + S->tolf) { /* elastic */
     for (int a = 0; a < 3; ++a) {
       eps[a] = eps_tr[a];
       tau[a] = m->K * tr + 2.0 * m->G * (eps_tr[a] - tr / 3.0);
     }
+    *done = 1;
     return MPMC_SUCCESS;
   }
   info->plastic = 1;
-  const int perfect = m->eta == 0.0 ||
-                      (m->c_p == m->c_r && m->phi_p == m->phi_r && m->psi_p == m->psi_r);
-  const mc_region *regs = S.dp ? dp_regions : mc_regions;
-  const int nreg = S.dp ? (int)(sizeof dp_regions / sizeof dp_regions[0])
-                        : (int)(sizeof mc_regions / sizeof mc_regions[0]);
+  P->perfect = m->eta == 0.0 ||
+               (m->c_p == m->c_r && m->phi_p == m->phi_r && m->psi_p == m->psi_r);
+  S->n = 1; /* the first region, Mohr-Coulomb's main plane or Drucker-Prager's cone */
+  S->act[0] = S->dp ? S_DP : S_A;
+  return MPMC_SUCCESS;
+}
+
+/* principal after its first region: fs what single_solve gave (0 solved, 1 not
+ * admissible, 2 not solved; -1 not tried) with y, s, q, R0; then the other regions in order
+ * and the result as principal's. */
+static int principal_end(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double *eps_p,
+                         double eps[3], double tau[3], mpmc_mc_info *info, mc_point *P, int fs,
+                         const double *y, double s[3], const mc_mat *qs, double R0) {
+  mc_sys *const S = &P->S;
+  const int *perm = P->perm;
+  const int perfect = P->perfect;
+  const mc_region *regs = S->dp ? dp_regions : mc_regions;
+  const int nreg = S->dp ? (int)(sizeof dp_regions / sizeof dp_regions[0])
+                         : (int)(sizeof mc_regions / sizeof mc_regions[0]);
+  double ep_new = S->ep0;
   int found = 0, r0 = 0;
-  if (perfect || solver == MPMC_SOLVER_AUTO) { /* the first region in closed form */
-    double y[MC_NMAX] = {0, 0, 0, 0}, R0;
-    mc_mat q;
-    S.n = 1;
-    S.act[0] = regs[0].act[0];
-    const int fs = single_solve(&S, perfect, y, s, &q, &R0, info);
-    if (fs == 0) {
-      found = 1;
-      info->region = regs[0].region;
-      info->dgamma = y[0];
-      info->residual = fabs(R0);
-      ep_new = S.ep0 + y[1];
-      if (q.st_apex && s[0] - s[2] <= 8.0 * S.tolf) info->region = MPMC_MC_APEX;
-    } else if (fs == 1) {
-      r0 = 1; /* converged but not admissible: the general loop from the next region */
-    }
+  if (fs == 0) {
+    found = 1;
+    info->region = regs[0].region;
+    info->dgamma = y[0];
+    info->residual = fabs(R0);
+    ep_new = S->ep0 + y[1];
+    if (qs->st_apex && s[0] - s[2] <= 8.0 * S->tolf) info->region = MPMC_MC_APEX;
+  } else if (fs == 1) {
+    r0 = 1; /* converged but not admissible: the general loop from the next region */
   }
   /* the regions in order, but Mohr-Coulomb's extension edge before the compression edge when
    * the main plane's return breaks s2 >= s3 more than s1 >= s2 (an edge return tried both) */
   int order[16];
   for (int r = 0; r < nreg; ++r) order[r] = r;
-  if (r0 == 1 && !S.dp && s[2] - s[1] > s[1] - s[0]) order[1] = 2, order[2] = 1;
-  if (r0 == 1 && !S.dp) /* the edges, that order, by edge_solve while it decides */
+  if (r0 == 1 && !S->dp && s[2] - s[1] > s[1] - s[0]) order[1] = 2, order[2] = 1;
+  if (r0 == 1 && !S->dp) /* the edges, that order, by edge_solve while it decides */
     for (; r0 < 3 && !found; ++r0) {
       const mc_region *rg = &regs[order[r0]];
       double y[MC_NMAX], res;
       mc_mat q;
-      S.n = rg->n;
-      memcpy(S.act, rg->act, sizeof S.act);
-      const int es = edge_solve(&S, perfect, y, s, &q, &res, info);
+      S->n = rg->n;
+      memcpy(S->act, rg->act, sizeof S->act);
+      const int es = edge_solve(S, perfect, y, s, &q, &res, info);
       if (es == 2) break; /* the general loop from this region */
       if (es == 1) continue;
       found = 1;
       info->region = rg->region;
       info->dgamma = y[0] + y[1];
       info->residual = res;
-      ep_new = S.ep0 + y[2];
-      if (q.st_apex && s[0] - s[2] <= 8.0 * S.tolf) info->region = MPMC_MC_APEX;
+      ep_new = S->ep0 + y[2];
+      if (q.st_apex && s[0] - s[2] <= 8.0 * S->tolf) info->region = MPMC_MC_APEX;
     }
   for (int ro = r0; ro < nreg && !found; ++ro) {
     const int r = order[ro];
     int uses_t = 0;
     for (int j = 0; j < regs[r].n; ++j) uses_t |= regs[r].act[j] >= S_T1 && regs[r].act[j] <= S_T3;
-    if (uses_t && !tension_regions(m, &q0)) continue;
-    S.n = regs[r].n;
-    memcpy(S.act, regs[r].act, sizeof S.act);
+    if (uses_t && !tension_regions(m, &S->q0)) continue;
+    S->n = regs[r].n;
+    memcpy(S->act, regs[r].act, sizeof S->act);
     double y[MC_NMAX] = {0, 0, 0, 0}, R[MC_NMAX];
     int err = 0;
-    const int fail = solve_region(ws, solver, &S, perfect, y, info, &err);
+    const int fail = solve_region(ws, solver, S, perfect, y, info, &err);
     if (err) return err;
     if (fail) continue;
-    mc_mat q = S.q0; /* the material at the solution, and the stress and residuals there */
-    if (!perfect) mat_eval(m, sys_e(&S, y[S.n]), 1, &q, &S.q0);
-    mc_sys Se = S;
+    mc_mat q = S->q0; /* the material at the solution, and the stress and residuals there */
+    if (!perfect) mat_eval(m, sys_e(S, y[S->n]), 1, &q, &S->q0);
+    mc_sys Se = *S;
     Se.frozen = 1;
-    Se.e_frozen = perfect ? S.e0 : q.e;
+    Se.e_frozen = perfect ? S->e0 : q.e;
     Se.qf = q;
     sys_eval(&Se, y, R, NULL, s);
-    if (!admissible(&S, y, s, &q)) {
-      if (ro == 0 && !S.dp && s[2] - s[1] > s[1] - s[0]) order[1] = 2, order[2] = 1;
+    if (!admissible(S, y, s, &q)) {
+      if (ro == 0 && !S->dp && s[2] - s[1] > s[1] - s[0]) order[1] = 2, order[2] = 1;
       continue;
     }
     found = 1;
     info->region = regs[r].region;
     info->dgamma = 0.0;
     info->residual = 0.0;
-    for (int j = 0; j < S.n; ++j) {
+    for (int j = 0; j < S->n; ++j) {
       info->dgamma += y[j];
       info->residual = fmax(info->residual, fabs(R[j]));
     }
-    ep_new = S.ep0 + y[S.n];
+    ep_new = S->ep0 + y[S->n];
     /* a return to the apex through a cut-off capped there is the apex */
-    if (q.st_apex && s[0] - s[2] <= 8.0 * S.tolf) info->region = MPMC_MC_APEX;
+    if (q.st_apex && s[0] - s[2] <= 8.0 * S->tolf) info->region = MPMC_MC_APEX;
   }
   if (!found) {
     /* the hydrostatic point s = sigma_c 1, sigma_c the cut-off or the apex: D follows from
      * the trial deviator alone, D = sqrt(2/3) |dev s_tr| / 2G */
-    const double p = (S.str[0] + S.str[1] + S.str[2]) / 3.0;
-    const double dv[3] = {S.str[0] - p, S.str[1] - p, S.str[2] - p};
+    const double p = (S->str[0] + S->str[1] + S->str[2]) / 3.0;
+    const double dv[3] = {S->str[0] - p, S->str[1] - p, S->str[2] - p};
     const double D = sqrt(2.0 / 3.0) * sqrt(dot3(dv, dv)) / (2.0 * m->G);
-    mc_mat q = S.q0;
-    if (!perfect) mat_eval(m, sys_e(&S, D), 1, &q, &S.q0);
+    mc_mat q = S->q0;
+    if (!perfect) mat_eval(m, sys_e(S, D), 1, &q, &S->q0);
     /* the volume must shrink back (the apex is reached by a volumetric plastic expansion) */
-    if (!isfinite(q.st) || !(p >= q.st - S.tolf)) return MPMC_ERR_SOLVER;
+    if (!isfinite(q.st) || !(p >= q.st - S->tolf)) return MPMC_ERR_SOLVER;
     s[0] = s[1] = s[2] = q.st;
-    ep_new = S.ep0 + D;
+    ep_new = S->ep0 + D;
     info->region = q.st_apex ? MPMC_MC_APEX : MPMC_MC_TENSION_CORNER;
     info->dgamma = (p - q.st) / m->K + D; /* volumetric and deviatoric parts, for the record */
     info->residual = 0.0;
@@ -1089,6 +1109,29 @@ static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const d
   }
   *eps_p = ep_new;
   return MPMC_SUCCESS;
+}
+
+/* mpmc_mc_return_principal for a material that passed param_ok, info zeroed; q0in: the
+ * material at *eps_p when the caller has it (mpmc_mc_update), else NULL. */
+/* principal after principal_begin: the first region in closed form, then principal_end */
+static int principal_rest(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, double *eps_p,
+                          double eps[3], double tau[3], mpmc_mc_info *info, mc_point *P) {
+  double y[MC_NMAX] = {0, 0, 0, 0}, s[3], R0 = 0.0;
+  mc_mat q;
+  int fs = -1;
+  if (P->perfect || solver == MPMC_SOLVER_AUTO)
+    fs = single_solve(&P->S, P->perfect, y, s, &q, &R0, info);
+  return principal_end(ws, solver, m, eps_p, eps, tau, info, P, fs, y, s, &q, R0);
+}
+
+static int principal(mpmc_rm_ws *ws, int solver, const mpmc_mc_param *m, const double eps_tr[3],
+                     double *eps_p, double eps[3], double tau[3], mpmc_mc_info *info,
+                     const mc_mat *q0in) {
+  mc_point P;
+  int done;
+  MPMC_CALL(principal_begin(m, eps_tr, eps_p, eps, tau, info, q0in, &P, &done));
+  if (done) return MPMC_SUCCESS;
+  return principal_rest(ws, solver, m, eps_p, eps, tau, info, &P);
 }
 
 /* The eigen path from the trial state: b its b_e, or (lg) eps = 1/2 ln b_e already formed by
@@ -1386,6 +1429,234 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
 }
 #endif
 
+/* Lane-wise compares: AVX's own; on the baseline build batch4.h's mask table (CMP4) */
+#if defined(__AVX__)
+#define MC_CMP4(a, op, b) ((l4)((a)op(b)))
+#else
+#define MC_CMP4(a, op, b) CMP4(a, op, b)
+#endif
+/* the lanes of x that are finite */
+#define MC_FINITE4(x) MC_CMP4((x) - (x), ==, ((v4){0.0, 0.0, 0.0, 0.0}))
+/* max_nn per lane */
+#define MC_MAX_NN4(a, b) SEL4(MC_CMP4(a, >=, b) | MC_CMP4(b, !=, b), a, b)
+
+/* Mohr-Coulomb's material of mat_eval's operations per lane for single_solve's Newton
+ * (frozen = 0, ref the lane's material at eps_p^n): the fields single_eval reads, from e */
+typedef struct {
+  v4 e, phi, psi, c, dc, dphi, sf, cf, ss, cs, dsf, dcf, dss;
+} mc_mat4;
+
+/* sin_cos_near per lane (lanes of m; libm where |d| > 0.1) */
+static inline void sin_cos_near4(const v4 *xp, const v4 *x0, const v4 *s0p, const v4 *c0p, int m,
+                                 v4 *s, v4 *c) {
+  const v4 x = *xp, s0 = *s0p, c0 = *c0p, d = x - *x0, ad = ABS4(d), d2 = d * d;
+  const v4 t = {0x1p-9, 0x1p-9, 0x1p-9, 0x1p-9}, f = {0.1, 0.1, 0.1, 0.1};
+  v4 sd = d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120));
+  v4 cm = d2 * (0.5 + d2 * (-1.0 / 24 + d2 * (1.0 / 720)));
+  const l4 small = MC_CMP4(ad, <=, t);
+  if (m & ~mask_bits(&small)) {
+    const v4 sd6 = d + d * d2 * (-1.0 / 6 + d2 * (1.0 / 120 + d2 * (-1.0 / 5040 + d2 * (1.0 / 362880 + d2 * (-1.0 / 39916800)))));
+    const v4 cm6 = d2 * (0.5 + d2 * (-1.0 / 24 + d2 * (1.0 / 720 + d2 * (-1.0 / 40320 + d2 * (1.0 / 3628800)))));
+    sd = SEL4(small, sd, sd6);
+    cm = SEL4(small, cm, cm6);
+  }
+  *s = s0 + (c0 * sd - s0 * cm);
+  *c = c0 - (s0 * sd + c0 * cm);
+  const l4 nearm = MC_CMP4(ad, <=, f);
+  const int far = m & ~mask_bits(&nearm);
+  for (int l = 0; l < 4; ++l)
+    if (far >> l & 1) {
+      (*s)[l] = sin(x[l]);
+      (*c)[l] = cos(x[l]);
+    }
+}
+
+/* single_eval's main plane per lane: R0, R1, the stress s and (J) the Jacobian */
+static inline void single_eval4(const mpmc_mc_param *m, const v4 *str, const mc_mat4 *q,
+                                const v4 *gp, const v4 *y1p, v4 *R0, v4 *R1, v4 J[2][2],
+                                v4 s[3]) {
+  const v4 g = *gp, y1 = *y1p;
+  const double c23 = sqrt(2.0 / 3.0);
+  const double lam = m->K - 2.0 * m->G / 3.0, G2 = 2.0 * m->G;
+  const v4 a0 = 1.0 + q->sf, a2 = -(1.0 - q->sf), N0 = 1.0 + q->ss, N2 = -(1.0 - q->ss);
+  const v4 M0 = g * N0, M2 = g * N2, trM = M0 + M2;
+  s[0] = str[0] - (lam * trM + G2 * M0);
+  s[1] = str[1] - lam * trM;
+  s[2] = str[2] - (lam * trM + G2 * M2);
+  *R0 = a0 * s[0] + a2 * s[2] - 2.0 * q->c * q->cf;
+  const v4 t3 = trM / 3.0;
+  v4 u[3] = {M0 - t3, -t3, M2 - t3}, nd;
+  const v4 nn = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+  sqrt4(&nn, &nd);
+  *R1 = y1 - c23 * nd;
+  if (!J) return;
+  const v4 zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
+  const l4 pos = MC_CMP4(nd, >, zero);
+  const v4 nds = SEL4(pos, nd, one);
+  for (int i = 0; i < 3; i += 2) u[i] = SEL4(pos, u[i] / nds, zero);
+  const v4 trN = N0 + N2, dM = g * q->dss;
+  J[0][0] = -(a0 * (lam * trN + G2 * N0) + a2 * (lam * trN + G2 * N2));
+  J[1][0] = -c23 * (u[0] * N0 + u[2] * N2);
+  const v4 DdM0 = lam * 2.0 * dM + G2 * dM;
+  J[0][1] = q->dsf * (s[0] + s[2]) - 2.0 * (q->dc * q->cf + q->c * q->dcf) - (a0 + a2) * DdM0;
+  J[1][1] = 1.0 - c23 * (u[0] + u[2]) * dM;
+}
+
+/* single_solve of Mohr-Coulomb's main plane for the lanes of L (P[l] set up by
+ * principal_begin, S->n = 1): its operations lane by lane, Newton's iterates of all lanes
+ * together, each lane stopping where single_solve stops.  Gives what single_solve gives
+ * each lane but admissible's verdict: y, s, q, R0 and fs[l] (0, or 2 when not solved; then
+ * admissible per lane makes 0 or 1); info[l].newton_iters as single_solve counts them. */
+static void main_plane4(mc_point P[4], int L, mpmc_mc_info info[4], double y[4][MC_NMAX],
+                        double s[4][3], mc_mat q[4], double R0[4], int fs[4]) {
+  const mpmc_mc_param *m = P[__builtin_ctz((unsigned)L)].S.m;
+  const int perfect = P[__builtin_ctz((unsigned)L)].perfect;
+  const v4 zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
+  v4 str[3], tolf, e0, ep0;
+  mc_mat4 q0, qv;
+  for (int l = 0; l < 4; ++l) { /* the other lanes: copies of the first of L */
+    const mc_sys *S = &P[L >> l & 1 ? l : __builtin_ctz((unsigned)L)].S;
+    const mc_mat *a = &S->q0;
+    for (int k = 0; k < 3; ++k) str[k][l] = S->str[k];
+    tolf[l] = S->tolf, e0[l] = S->e0, ep0[l] = S->ep0;
+    q0.e[l] = a->e, q0.phi[l] = a->phi, q0.psi[l] = a->psi, q0.c[l] = a->c, q0.dc[l] = a->dc;
+    q0.dphi[l] = a->dphi, q0.sf[l] = a->sf, q0.cf[l] = a->cf, q0.ss[l] = a->ss;
+    q0.cs[l] = a->cs, q0.dsf[l] = a->dsf, q0.dcf[l] = a->dcf, q0.dss[l] = a->dss;
+  }
+  /* the perfect-plasticity predictor at eps_p^n */
+  v4 R0v, R1v, J[2][2], sv[3], y0, y1 = zero, R0k;
+  single_eval4(m, str, &q0, &zero, &zero, &R0v, &R1v, J, sv);
+  y0 = -R0v / J[0][0];
+  const l4 bad = ~(MC_CMP4(J[0][0], !=, zero) & MC_FINITE4(y0));
+  int live = L, bbits = L & mask_bits(&bad);
+  if (bbits) {
+    if (perfect) {
+      for (int l = 0; l < 4; ++l)
+        if (bbits >> l & 1) {
+          fs[l] = 2;
+          for (int k = 0; k < 3; ++k) s[l][k] = sv[k][l];
+          y[l][0] = y0[l], y[l][1] = 0.0, y[l][2] = y[l][3] = 0.0;
+        }
+      live &= ~bbits;
+      if (!live) return;
+    }
+    y0 = SEL4(bad, zero, y0);
+  }
+  {
+    v4 s2[3];
+    single_eval4(m, str, &q0, &y0, &zero, &R0v, &R1v, NULL, s2);
+    y1 = SEL4(bad, zero, -R1v);
+    for (int k = 0; k < 3; ++k) sv[k] = SEL4(bad, sv[k], s2[k]);
+  }
+  int ok = 0;
+  if (perfect) {
+    single_eval4(m, str, &q0, &y0, &y1, &R0v, &R1v, NULL, sv);
+    const v4 r = MC_MAX_NN4(ABS4(R0v), 2.0 * m->G * ABS4(R1v));
+    const l4 rok = MC_CMP4(r, <=, tolf);
+    ok = live & mask_bits(&rok);
+    qv = q0;
+    R0k = R0v;
+  } else {
+    const v4 eta = {m->eta, m->eta, m->eta, m->eta};
+    const double G2 = 2.0 * m->G;
+    v4 prev = {INFINITY, INFINITY, INFINITY, INFINITY};
+    int act = live, iters[4] = {0, 0, 0, 0};
+    qv = q0;
+    R0k = R0v;
+    for (int it = 0; it < MC_MAX_ITERS && act; ++it) {
+      /* mat_eval(m, sys_e(S, y1), 0, q, &S->q0) */
+      mc_mat4 qn;
+      const v4 x = m->eta * y1;
+      qn.e = e0 * MPMC_RM_EXP_NEG_POLY(x);
+      const v4 ax = ABS4(x), xs = {MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL,
+                                   MPMC_RM_EXP_SMALL};
+      const l4 xsm = MC_CMP4(ax, <=, xs);
+      const int big = act & ~mask_bits(&xsm);
+      for (int l = 0; l < 4; ++l)
+        if (big >> l & 1) qn.e[l] = exp(-m->eta * (ep0[l] + y1[l]));
+      const v4 de = -eta * qn.e;
+      qn.phi = m->phi_r + (m->phi_p - m->phi_r) * qn.e;
+      qn.psi = m->psi_r + (m->psi_p - m->psi_r) * qn.e;
+      qn.c = m->c_r + (m->c_p - m->c_r) * qn.e;
+      qn.dc = (m->c_p - m->c_r) * de;
+      qn.dphi = (m->phi_p - m->phi_r) * de;
+      const v4 dpsi = (m->psi_p - m->psi_r) * de;
+      sin_cos_near4(&qn.phi, &q0.phi, &q0.sf, &q0.cf, act, &qn.sf, &qn.cf);
+      sin_cos_near4(&qn.psi, &q0.psi, &q0.ss, &q0.cs, act, &qn.ss, &qn.cs);
+      qn.dsf = qn.cf * qn.dphi;
+      qn.dcf = -qn.sf * qn.dphi;
+      qn.dss = qn.cs * dpsi;
+      v4 sn[3];
+      single_eval4(m, str, &qn, &y0, &y1, &R0v, &R1v, J, sn);
+      /* rnorm */
+      v4 r = MC_MAX_NN4(zero, ABS4(R0v));
+      r = MC_MAX_NN4(r, G2 * ABS4(R1v));
+      const l4 rf = MC_FINITE4(r);
+      const v4 nr = SEL4(rf, r / SEL4(rf, tolf, one), ((v4){INFINITY, INFINITY, INFINITY, INFINITY}));
+      /* the lanes of this iterate keep its material and stress */
+      const l4 am = mpmc_lane_mask[act];
+      qv.e = SEL4(am, qn.e, qv.e), qv.phi = SEL4(am, qn.phi, qv.phi);
+      qv.psi = SEL4(am, qn.psi, qv.psi), qv.c = SEL4(am, qn.c, qv.c);
+      qv.sf = SEL4(am, qn.sf, qv.sf), qv.cf = SEL4(am, qn.cf, qv.cf);
+      qv.ss = SEL4(am, qn.ss, qv.ss), qv.cs = SEL4(am, qn.cs, qv.cs);
+      for (int k = 0; k < 3; ++k) sv[k] = SEL4(am, sn[k], sv[k]);
+      R0k = SEL4(am, R0v, R0k);
+      const l4 nok = MC_CMP4(nr, <=, one);
+      const int conv = act & mask_bits(&nok);
+      ok |= conv;
+      act &= ~conv;
+      const v4 half = 0.5 * prev;
+      const l4 nf = MC_FINITE4(nr), ngrow = MC_CMP4(nr, >, half);
+      int stop = ~mask_bits(&nf);
+      if (it >= 3) stop |= mask_bits(&ngrow);
+      const v4 det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+      const l4 dok = MC_CMP4(det, !=, zero) & MC_FINITE4(det), dneg = MC_CMP4(det * J[0][0], <=, zero);
+      stop |= ~mask_bits(&dok) | mask_bits(&dneg);
+      act &= ~stop;
+      if (!act) break;
+      const l4 an = mpmc_lane_mask[act];
+      const v4 dets = SEL4(an, det, one);
+      y0 = SEL4(an, y0 + (-R0v * J[1][1] + R1v * J[0][1]) / dets, y0);
+      y1 = SEL4(an, y1 + (-R1v * J[0][0] + R0v * J[1][0]) / dets, y1);
+      prev = SEL4(an, nr, prev);
+      for (int l = 0; l < 4; ++l) iters[l] += act >> l & 1;
+    }
+    for (int l = 0; l < 4; ++l)
+      if (ok >> l & 1) info[l].newton_iters += iters[l];
+  }
+  for (int l = 0; l < 4; ++l) {
+    if (!(live >> l & 1)) continue;
+    y[l][0] = y0[l], y[l][1] = y1[l], y[l][2] = y[l][3] = 0.0;
+    for (int k = 0; k < 3; ++k) s[l][k] = sv[k][l];
+    R0[l] = R0k[l];
+    if (!(ok >> l & 1)) {
+      fs[l] = 2;
+      continue;
+    }
+    mc_mat *a = &q[l];
+    if (perfect)
+      *a = P[l].S.q0;
+    else { /* mat_eval's other fields at the lane's e; the derivatives 0 (single_solve) */
+      a->e = qv.e[l], a->phi = qv.phi[l], a->psi = qv.psi[l], a->c = qv.c[l];
+      a->sf = qv.sf[l], a->cf = qv.cf[l], a->ss = qv.ss[l], a->cs = qv.cs[l];
+      a->dc = a->dphi = a->dsf = a->dcf = a->dss = a->deta = a->dxi = a->detab = a->dst = 0.0;
+      a->eta = a->xi = a->etab = 0.0;
+      a->st = m->sigma_t;
+      a->st_apex = 0;
+      double apex = INFINITY;
+      if (a->sf > 0.0) {
+        const double isf = 1.0 / a->sf;
+        apex = a->c * a->cf * isf;
+      }
+      if (!(a->st < apex)) {
+        a->st = apex;
+        a->st_apex = isfinite(apex);
+      }
+    }
+    fs[l] = admissible(&P[l].S, y[l], s[l], a) ? 0 : 1;
+  }
+}
+
 /**
  * @brief mpmc_mc_update of four points at once (return_mc.h): lane l of the block is point
  * F[l], be[l], eps_p[l], tau[l], J_out[l], info[l], err[l] (its return value), l < n <= 4.
@@ -1510,11 +1781,15 @@ void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pr
   v4 lam[3], Q[9];
   l4 fb;
   sym3_eig_closed4(eps, &eigm, lam, Q, &fb);
-  /* the principal return per lane (return_decomposed's), its strains and stresses e, t */
+  /* the principal return per lane (return_decomposed's), its strains and stresses e, t:
+   * principal's set-up per lane, Mohr-Coulomb's main plane for the lanes that try it four at
+   * a time (main_plane4), the other regions per lane */
   const v4 zero = {0.0, 0.0, 0.0, 0.0};
   v4 ev[3] = {zero, zero, zero}, tv[3] = {zero, zero, zero};
-  double epn[4];
-  int done = 0;
+  double epn[4], el[4][3], tl[4][3];
+  mpmc_mc_info loc[4];
+  mc_point P[4];
+  int done = 0, plane = 0, rest = 0;
   for (int bits = mask_bits(&eigm), l = 0; bits; bits >>= 1, ++l) {
     if (!(bits & 1)) continue;
     if (fb[l]) { /* a special case of the closed form: its scalar code */
@@ -1527,18 +1802,52 @@ void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pr
       }
     }
     const double etr[3] = {lam[0][l], lam[1][l], lam[2][l]};
-    double e[3], t[3];
-    mpmc_mc_info local, *inf = info ? &info[l] : &local;
+    mpmc_mc_info *inf = info ? &info[l] : &loc[l];
     memset(inf, 0, sizeof *inf);
     epn[l] = eps_p[l];
-    err[l] = principal(ws, solver, &pre->m, etr, &epn[l], e, t, inf, &q0[l]);
+    int dn;
+    err[l] = principal_begin(&pre->m, etr, &epn[l], el[l], tl[l], inf, &q0[l], &P[l], &dn);
     if (err[l]) continue;
-    for (int a = 0; a < 3; ++a) {
-      ev[a][l] = e[a];
-      tv[a][l] = t[a];
-    }
-    done |= 1 << l;
+    if (dn)
+      done |= 1 << l;
+    else if (mc && (P[l].perfect || solver == MPMC_SOLVER_AUTO))
+      plane |= 1 << l;
+    else
+      rest |= 1 << l;
   }
+  if (plane) {
+    double y[4][MC_NMAX], sl[4][3], R0[4];
+    mc_mat q[4];
+    int fs[4];
+    if (plane & (plane - 1)) /* two lanes or more */
+      main_plane4(P, plane, info ? info : loc, y, sl, q, R0, fs);
+    else
+      for (int l = 0; l < 4; ++l)
+        if (plane >> l & 1) {
+          for (int i = 0; i < MC_NMAX; ++i) y[l][i] = 0.0;
+          R0[l] = 0.0;
+          fs[l] = single_solve(&P[l].S, P[l].perfect, y[l], sl[l], &q[l], &R0[l],
+                               info ? &info[l] : &loc[l]);
+        }
+    for (int l = 0; l < 4; ++l) {
+      if (!(plane >> l & 1)) continue;
+      err[l] = principal_end(ws, solver, &pre->m, &epn[l], el[l], tl[l], info ? &info[l] : &loc[l],
+                             &P[l], fs[l], y[l], sl[l], &q[l], R0[l]);
+      if (!err[l]) done |= 1 << l;
+    }
+  }
+  for (int l = 0; l < 4; ++l) {
+    if (!(rest >> l & 1)) continue;
+    err[l] = principal_rest(ws, solver, &pre->m, &epn[l], el[l], tl[l], info ? &info[l] : &loc[l],
+                            &P[l]);
+    if (!err[l]) done |= 1 << l;
+  }
+  for (int l = 0; l < 4; ++l)
+    if (done >> l & 1)
+      for (int a = 0; a < 3; ++a) {
+        ev[a][l] = el[l][a];
+        tv[a][l] = tl[l][a];
+      }
   if (!done) return;
   /* return_decomposed's recomposition, its operations lane by lane: b_e's eigenvalues
    * q_a.b q_a exp(2 (eps_a - eps_tr,a)) (libm's exp(2 eps_a) beyond the polynomial), b_e and
