@@ -104,7 +104,8 @@ static inline void sin_cos_near(double x, double x0, double s0, double c0, doubl
 
 /* x(eps_p) = x_r + (x_p - x_r) e with e = exp(-eta eps_p); derivative -eta (x_p - x_r) e.
  * ref: a material near this one (may be NULL), whose sines and cosines seed this one's. */
-static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q, const mc_mat *ref) {
+static inline __attribute__((always_inline)) void
+mat_eval_in(const mpmc_mc_param *m, double e, int frozen, mc_mat *q, const mc_mat *ref) {
   const double de = frozen ? 0.0 : -m->eta * e; /* de/d eps_p */
   q->e = e;
   const double phi = m->phi_r + (m->phi_p - m->phi_r) * e;
@@ -156,6 +157,10 @@ static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q, co
     q->dst = dapex;
     q->st_apex = isfinite(apex);
   }
+}
+
+static void mat_eval(const mpmc_mc_param *m, double e, int frozen, mc_mat *q, const mc_mat *ref) {
+  mat_eval_in(m, e, frozen, q, ref);
 }
 
 static inline double e_of(const mpmc_mc_param *m, double ep) {
@@ -238,9 +243,9 @@ static inline double dp_f(const mc_mat *q, const double s[3]) {
 
 /* Residuals R[0..n], the Jacobian J (may be NULL) and the stress sig (may be NULL) of a
  * region of planes at y. */
-static void eval_planes_q(const mc_sys *S, const mc_mat *q, const double *y, double *R,
-                          double J[MC_NMAX][MC_NMAX], double sig[3]) {
-  const int n = S->n;
+static inline __attribute__((always_inline)) void
+eval_planes_n(const mc_sys *S, const int n, const mc_mat *q, const double *y, double *R,
+              double J[MC_NMAX][MC_NMAX], double sig[3]) {
   const mpmc_mc_param *m = S->m;
   double a[3][3], da[3][3], N[3][3], dN[3][3], k[3], dk[3], M[3] = {0, 0, 0}, dM[3] = {0, 0, 0};
   for (int j = 0; j < n; ++j) {
@@ -272,6 +277,15 @@ static void eval_planes_q(const mc_sys *S, const mc_mat *q, const double *y, dou
   }
   for (int i = 0; i < n; ++i) J[i][n] = dot3(da[i], s) - dk[i] - dot3(a[i], DdM);
   J[n][n] = 1.0 - c23 * dot3(u, dM);
+}
+static void eval_planes_q(const mc_sys *S, const mc_mat *q, const double *y, double *R,
+                          double J[MC_NMAX][MC_NMAX], double sig[3]) {
+  eval_planes_n(S, S->n, q, y, R, J, sig);
+}
+/* the same for an edge of two planes (edge_solve): its loops of known length */
+static void eval_planes_2(const mc_sys *S, const mc_mat *q, const double *y, double *R,
+                          double J[MC_NMAX][MC_NMAX], double sig[3]) {
+  eval_planes_n(S, 2, q, y, R, J, sig);
 }
 static void eval_planes(const mc_sys *S, const double *y, double *R, double J[MC_NMAX][MC_NMAX],
                         double sig[3]) {
@@ -351,7 +365,9 @@ static inline double rnorm(const mc_sys *S, const double *R) {
 }
 
 /* Gaussian elimination with partial pivoting of A x = b (n <= 4); b <- x; returns det A. */
-static double gauss(int n, double A[MC_NMAX][MC_NMAX], double *b) {
+static inline __attribute__((always_inline)) double gauss_n(const int n,
+                                                            double A[MC_NMAX][MC_NMAX],
+                                                            double *b) {
   double det = 1.0;
   for (int k = 0; k < n; ++k) {
     int p = k;
@@ -383,6 +399,8 @@ static double gauss(int n, double A[MC_NMAX][MC_NMAX], double *b) {
   }
   return det;
 }
+
+static double gauss(int n, double A[MC_NMAX][MC_NMAX], double *b) { return gauss_n(n, A, b); }
 
 /* det of the leading n x n block (n <= 3) */
 static double det_lead(int n, double J[MC_NMAX][MC_NMAX]) {
@@ -784,7 +802,7 @@ static int edge_solve(const mc_sys *S, int perfect, double *y, double s[3], mc_m
   double R[MC_NMAX], J[MC_NMAX][MC_NMAX];
   const int iters0 = info->newton_iters;
   for (int i = 0; i < MC_NMAX; ++i) y[i] = 0.0;
-  eval_planes_q(S, &S->q0, y, R, J, NULL);
+  eval_planes_2(S, &S->q0, y, R, J, NULL);
   const double d0 = J[0][0] * J[1][1] - J[0][1] * J[1][0];
   const double y0 = (-R[0] * J[1][1] + R[1] * J[0][1]) / d0;
   const double y1 = (-R[1] * J[0][0] + R[0] * J[1][0]) / d0;
@@ -793,20 +811,20 @@ static int edge_solve(const mc_sys *S, int perfect, double *y, double s[3], mc_m
   } else {
     y[0] = y0;
     y[1] = y1;
-    eval_planes_q(S, &S->q0, y, R, NULL, NULL);
+    eval_planes_2(S, &S->q0, y, R, NULL, NULL);
     y[2] = -R[2];
   }
   if (perfect) {
     *q = S->q0;
-    eval_planes_q(S, q, y, R, NULL, s);
+    eval_planes_2(S, q, y, R, NULL, s);
     if (!(rnorm(S, R) <= 1.0)) return 2;
   } else {
     double prev = INFINITY;
     int ok = 0;
     for (int it = 0; it < MC_MAX_ITERS; ++it) {
       double dx[MC_NMAX];
-      mat_eval(S->m, sys_e(S, y[2]), 0, q, &S->q0);
-      eval_planes_q(S, q, y, R, J, s);
+      mat_eval_in(S->m, sys_e(S, y[2]), 0, q, &S->q0); /* inlined: the edges' hot loop */
+      eval_planes_2(S, q, y, R, J, s);
       const double nr = rnorm(S, R);
       if (nr <= 1.0) {
         ok = 1;
@@ -815,7 +833,7 @@ static int edge_solve(const mc_sys *S, int perfect, double *y, double s[3], mc_m
       if (!isfinite(nr) || (it >= 3 && nr > 0.5 * prev)) break;
       const double detyy = det_lead(2, J);
       for (int i = 0; i < 3; ++i) dx[i] = -R[i];
-      const double det = gauss(3, J, dx);
+      const double det = gauss_n(3, J, dx); /* its loops of known length */
       if (!(det != 0.0) || !isfinite(det) || det * detyy <= 0.0) break;
       info->newton_iters++;
       for (int i = 0; i < 3; ++i) y[i] += dx[i];
@@ -960,15 +978,22 @@ static int principal_begin(const mpmc_mc_param *m, const double eps_tr[3], const
         *eps_p >= 0))
     return MPMC_ERR_NUMERIC;
   /* sort: perm[k] = the input index of the k-th largest */
+  /* a bubble sort's three compares and swaps, in registers (conditional moves) */
+  int p0 = 0, p1 = 1, p2 = 2;
+  double v0 = eps_tr[0], v1 = eps_tr[1], v2 = eps_tr[2];
+#define MC_SWAP_LT(pa, va, pb, vb)                                                         \
+  do {                                                                                   \
+    const int lt_ = va < vb, pt_ = pa;                                                   \
+    const double vt_ = va;                                                               \
+    pa = lt_ ? pb : pa, va = lt_ ? vb : va;                                              \
+    pb = lt_ ? pt_ : pb, vb = lt_ ? vt_ : vb;                                            \
+  } while (0)
+  MC_SWAP_LT(p0, v0, p1, v1);
+  MC_SWAP_LT(p1, v1, p2, v2);
+  MC_SWAP_LT(p0, v0, p1, v1);
+#undef MC_SWAP_LT
   int *perm = P->perm;
-  perm[0] = 0, perm[1] = 1, perm[2] = 2;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2 - i; ++j)
-      if (eps_tr[perm[j]] < eps_tr[perm[j + 1]]) {
-        const int t = perm[j];
-        perm[j] = perm[j + 1];
-        perm[j + 1] = t;
-      }
+  perm[0] = p0, perm[1] = p1, perm[2] = p2;
   const double tr = eps_tr[0] + eps_tr[1] + eps_tr[2];
   mc_sys *const S = &P->S; /* not zeroed as a whole: ~0.5 kB, a tenth of a fast return */
   S->m = m;
@@ -981,9 +1006,9 @@ static int principal_begin(const mpmc_mc_param *m, const double eps_tr[3], const
   S->tolf = tolerance(m, S->str);
   S->yscale = max_nn(fabs(S->str[0]), fabs(S->str[2])) / m->G + 1e-300;
   S->e0 = q0in ? q0in->e : e_of(m, S->ep0);
-  if (q0in)
-    S->q0 = *q0in;
-  else
+  if (q0in) {
+    if (q0in != &S->q0) S->q0 = *q0in; /* mpmc_mc_update4 leaves it in place */
+  } else
     mat_eval(m, S->e0, 1, &S->q0, NULL);
   const mc_mat *q0 = &S->q0;
   const double f0 = S->dp ? dp_f(q0, S->str) : mc_f(q0, S->str, 0, 2);
@@ -1272,20 +1297,21 @@ static int elastic_fast(const mpmc_mc_pre *pre, const double *b, double eps_p, d
 static inline void check_mat(const mpmc_mc_pre *pre, double eps_p, mc_mat *qout, double c[5]) {
   const mpmc_mc_param *m = &pre->m;
   c[0] = pre->sf, c[1] = pre->k, c[2] = pre->eta, c[3] = pre->gmax, c[4] = pre->st;
-  *qout = pre->q0;
-  if (pre->perfect && eps_p != 0.0 && m->eta > 0.0) qout->e = e_of(m, eps_p);
-  if (!(pre->perfect || eps_p == 0.0)) {
-    mc_mat q;
-    /* the sines and cosines from those of the nearest of pre's materials (sin_cos_near) */
+  if (pre->perfect || eps_p == 0.0) {
+    *qout = pre->q0;
+    if (pre->perfect && eps_p != 0.0 && m->eta > 0.0) qout->e = e_of(m, eps_p);
+  } else {
+    /* the sines and cosines from those of the nearest of pre's materials (sin_cos_near),
+     * written in place (a copy of the struct just written would wait on its stores) */
+    mc_mat *q = qout;
     const double ee = e_of(m, eps_p);
     const int kr = (int)(ee * (MPMC_MC_NREF - 1) + 0.5);
-    mat_eval(m, ee, 1, &q, &pre->ref[kr < 0 ? 0 : kr > MPMC_MC_NREF - 1 ? MPMC_MC_NREF - 1 : kr]);
-    *qout = q;
-    c[0] = q.sf;
-    c[1] = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q.c * q.cf : q.xi * q.c;
-    c[2] = q.eta;
+    mat_eval(m, ee, 1, q, &pre->ref[kr < 0 ? 0 : kr > MPMC_MC_NREF - 1 ? MPMC_MC_NREF - 1 : kr]);
+    c[0] = q->sf;
+    c[1] = m->surface == MPMC_MC_MOHR_COULOMB ? 2.0 * q->c * q->cf : q->xi * q->c;
+    c[2] = q->eta;
     c[3] = sqrt(1.0 + c[0] * c[0] / 3.0);
-    c[4] = q.st;
+    c[4] = q->st;
   }
 }
 
@@ -1471,6 +1497,57 @@ static inline void sin_cos_near4(const v4 *xp, const v4 *x0, const v4 *s0p, cons
     }
 }
 
+/* check_mat of Mohr-Coulomb's softened lanes (lanes of L: eps_p > 0, softening), mat_eval's
+ * operations per lane (frozen, seeded by the nearest of pre's materials) into P[l].S.q0 and
+ * the lanes of c */
+static void check_mat4(const mpmc_mc_pre *pre, const double *eps_p, int L, mc_point P[4],
+                       v4 c[5]) {
+  const mpmc_mc_param *m = &pre->m;
+  const v4 zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
+  v4 e = one, rphi, rsf, rcf, rpsi, rss, rcs;
+  for (int l = 0; l < 4; ++l) {
+    const mc_mat *r = &pre->ref[MPMC_MC_NREF - 1];
+    if (L >> l & 1) {
+      e[l] = e_of(m, eps_p[l]);
+      const int kr = (int)(e[l] * (MPMC_MC_NREF - 1) + 0.5);
+      r = &pre->ref[kr < 0 ? 0 : kr > MPMC_MC_NREF - 1 ? MPMC_MC_NREF - 1 : kr];
+    }
+    rphi[l] = r->phi, rsf[l] = r->sf, rcf[l] = r->cf, rpsi[l] = r->psi, rss[l] = r->ss;
+    rcs[l] = r->cs;
+  }
+  const double de = 0.0; /* frozen */
+  const v4 phi = m->phi_r + (m->phi_p - m->phi_r) * e, psi = m->psi_r + (m->psi_p - m->psi_r) * e;
+  const v4 cc = m->c_r + (m->c_p - m->c_r) * e;
+  const double dc = (m->c_p - m->c_r) * de, dphi = (m->phi_p - m->phi_r) * de;
+  const double dpsi = (m->psi_p - m->psi_r) * de;
+  v4 sf, cf, ss, cs;
+  sin_cos_near4(&phi, &rphi, &rsf, &rcf, L, &sf, &cf);
+  sin_cos_near4(&psi, &rpsi, &rss, &rcs, L, &ss, &cs);
+  const v4 dsf = cf * dphi, dcf = -sf * dphi, dss = cs * dpsi;
+  const l4 pos = MC_CMP4(sf, >, zero);
+  const v4 isf = 1.0 / SEL4(pos, sf, one);
+  const v4 inf = {INFINITY, INFINITY, INFINITY, INFINITY};
+  const v4 apex = SEL4(pos, cc * cf * isf, inf);
+  const v4 dapex = SEL4(pos, dc * cf * isf - cc * dphi * (isf * isf), zero);
+  const v4 st0 = {m->sigma_t, m->sigma_t, m->sigma_t, m->sigma_t};
+  const l4 lt = MC_CMP4(st0, <, apex), fa = MC_FINITE4(apex);
+  const v4 st = SEL4(lt, st0, apex), dst = SEL4(lt, zero, dapex);
+  v4 g2 = 1.0 + sf * sf / 3.0, gmax;
+  sqrt4(&g2, &gmax);
+  const v4 k = 2.0 * cc * cf;
+  for (int l = 0; l < 4; ++l) {
+    if (!(L >> l & 1)) continue;
+    mc_mat *q = &P[l].S.q0;
+    q->e = e[l], q->phi = phi[l], q->psi = psi[l], q->c = cc[l], q->dc = dc, q->dphi = dphi;
+    q->sf = sf[l], q->cf = cf[l], q->ss = ss[l], q->cs = cs[l];
+    q->dsf = dsf[l], q->dcf = dcf[l], q->dss = dss[l];
+    q->eta = q->xi = q->etab = q->deta = q->dxi = q->detab = 0.0;
+    q->st = st[l], q->dst = dst[l];
+    q->st_apex = !lt[l] && fa[l];
+    c[0][l] = sf[l], c[1][l] = k[l], c[2][l] = 0.0, c[3][l] = gmax[l], c[4][l] = st[l];
+  }
+}
+
 /* single_eval's main plane per lane: R0, R1, the stress s and (J) the Jacobian */
 static inline void single_eval4(const mpmc_mc_param *m, const v4 *str, const mc_mat4 *q,
                                 const v4 *gp, const v4 *y1p, v4 *R0, v4 *R1, v4 J[2][2],
@@ -1514,15 +1591,20 @@ static void main_plane4(mc_point P[4], int L, mpmc_mc_info info[4], double y[4][
   const v4 zero = {0.0, 0.0, 0.0, 0.0}, one = {1.0, 1.0, 1.0, 1.0};
   v4 str[3], tolf, e0, ep0;
   mc_mat4 q0, qv;
-  for (int l = 0; l < 4; ++l) { /* the other lanes: copies of the first of L */
-    const mc_sys *S = &P[L >> l & 1 ? l : __builtin_ctz((unsigned)L)].S;
-    const mc_mat *a = &S->q0;
-    for (int k = 0; k < 3; ++k) str[k][l] = S->str[k];
-    tolf[l] = S->tolf, e0[l] = S->e0, ep0[l] = S->ep0;
-    q0.e[l] = a->e, q0.phi[l] = a->phi, q0.psi[l] = a->psi, q0.c[l] = a->c, q0.dc[l] = a->dc;
-    q0.dphi[l] = a->dphi, q0.sf[l] = a->sf, q0.cf[l] = a->cf, q0.ss[l] = a->ss;
-    q0.cs[l] = a->cs, q0.dsf[l] = a->dsf, q0.dcf[l] = a->dcf, q0.dss[l] = a->dss;
-  }
+  /* the lanes' systems (the other lanes: copies of the first of L), gathered by four
+   * loads a vector (in registers, not through a store and a wider load) */
+  const int l0 = __builtin_ctz((unsigned)L);
+  const mc_sys *S0 = &P[L & 1 ? 0 : l0].S, *S1 = &P[L & 2 ? 1 : l0].S;
+  const mc_sys *S2 = &P[L & 4 ? 2 : l0].S, *S3 = &P[L & 8 ? 3 : l0].S;
+#define MC_GATHER(f) ((v4){S0->f, S1->f, S2->f, S3->f})
+  for (int k = 0; k < 3; ++k) str[k] = MC_GATHER(str[k]);
+  tolf = MC_GATHER(tolf), e0 = MC_GATHER(e0), ep0 = MC_GATHER(ep0);
+  q0.e = MC_GATHER(q0.e), q0.phi = MC_GATHER(q0.phi), q0.psi = MC_GATHER(q0.psi);
+  q0.c = MC_GATHER(q0.c), q0.dc = MC_GATHER(q0.dc), q0.dphi = MC_GATHER(q0.dphi);
+  q0.sf = MC_GATHER(q0.sf), q0.cf = MC_GATHER(q0.cf), q0.ss = MC_GATHER(q0.ss);
+  q0.cs = MC_GATHER(q0.cs), q0.dsf = MC_GATHER(q0.dsf), q0.dcf = MC_GATHER(q0.dcf);
+  q0.dss = MC_GATHER(q0.dss);
+#undef MC_GATHER
   /* the perfect-plasticity predictor at eps_p^n */
   v4 R0v, R1v, J[2][2], sv[3], y0, y1 = zero, R0k;
   single_eval4(m, str, &q0, &zero, &zero, &R0v, &R1v, J, sv);
@@ -1554,24 +1636,24 @@ static void main_plane4(mc_point P[4], int L, mpmc_mc_info info[4], double y[4][
     const v4 r = MC_MAX_NN4(ABS4(R0v), 2.0 * m->G * ABS4(R1v));
     const l4 rok = MC_CMP4(r, <=, tolf);
     ok = live & mask_bits(&rok);
-    qv = q0;
     R0k = R0v;
   } else {
     const v4 eta = {m->eta, m->eta, m->eta, m->eta};
     const double G2 = 2.0 * m->G;
     v4 prev = {INFINITY, INFINITY, INFINITY, INFINITY};
     int act = live, iters[4] = {0, 0, 0, 0};
-    qv = q0;
-    R0k = R0v;
+    /* the lanes that have stopped keep their y, so that each iterate gives them the values
+     * of their last one again (libm too, where it takes over from the polynomials, in all
+     * the lanes of live): the loop's last values are every lane's own */
+    mc_mat4 qn;
     for (int it = 0; it < MC_MAX_ITERS && act; ++it) {
       /* mat_eval(m, sys_e(S, y1), 0, q, &S->q0) */
-      mc_mat4 qn;
       const v4 x = m->eta * y1;
       qn.e = e0 * MPMC_RM_EXP_NEG_POLY(x);
       const v4 ax = ABS4(x), xs = {MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL, MPMC_RM_EXP_SMALL,
                                    MPMC_RM_EXP_SMALL};
       const l4 xsm = MC_CMP4(ax, <=, xs);
-      const int big = act & ~mask_bits(&xsm);
+      const int big = live & ~mask_bits(&xsm);
       for (int l = 0; l < 4; ++l)
         if (big >> l & 1) qn.e[l] = exp(-m->eta * (ep0[l] + y1[l]));
       const v4 de = -eta * qn.e;
@@ -1581,26 +1663,17 @@ static void main_plane4(mc_point P[4], int L, mpmc_mc_info info[4], double y[4][
       qn.dc = (m->c_p - m->c_r) * de;
       qn.dphi = (m->phi_p - m->phi_r) * de;
       const v4 dpsi = (m->psi_p - m->psi_r) * de;
-      sin_cos_near4(&qn.phi, &q0.phi, &q0.sf, &q0.cf, act, &qn.sf, &qn.cf);
-      sin_cos_near4(&qn.psi, &q0.psi, &q0.ss, &q0.cs, act, &qn.ss, &qn.cs);
+      sin_cos_near4(&qn.phi, &q0.phi, &q0.sf, &q0.cf, live, &qn.sf, &qn.cf);
+      sin_cos_near4(&qn.psi, &q0.psi, &q0.ss, &q0.cs, live, &qn.ss, &qn.cs);
       qn.dsf = qn.cf * qn.dphi;
       qn.dcf = -qn.sf * qn.dphi;
       qn.dss = qn.cs * dpsi;
-      v4 sn[3];
-      single_eval4(m, str, &qn, &y0, &y1, &R0v, &R1v, J, sn);
+      single_eval4(m, str, &qn, &y0, &y1, &R0v, &R1v, J, sv);
       /* rnorm */
       v4 r = MC_MAX_NN4(zero, ABS4(R0v));
       r = MC_MAX_NN4(r, G2 * ABS4(R1v));
       const l4 rf = MC_FINITE4(r);
       const v4 nr = SEL4(rf, r / SEL4(rf, tolf, one), ((v4){INFINITY, INFINITY, INFINITY, INFINITY}));
-      /* the lanes of this iterate keep its material and stress */
-      const l4 am = mpmc_lane_mask[act];
-      qv.e = SEL4(am, qn.e, qv.e), qv.phi = SEL4(am, qn.phi, qv.phi);
-      qv.psi = SEL4(am, qn.psi, qv.psi), qv.c = SEL4(am, qn.c, qv.c);
-      qv.sf = SEL4(am, qn.sf, qv.sf), qv.cf = SEL4(am, qn.cf, qv.cf);
-      qv.ss = SEL4(am, qn.ss, qv.ss), qv.cs = SEL4(am, qn.cs, qv.cs);
-      for (int k = 0; k < 3; ++k) sv[k] = SEL4(am, sn[k], sv[k]);
-      R0k = SEL4(am, R0v, R0k);
       const l4 nok = MC_CMP4(nr, <=, one);
       const int conv = act & mask_bits(&nok);
       ok |= conv;
@@ -1623,6 +1696,8 @@ static void main_plane4(mc_point P[4], int L, mpmc_mc_info info[4], double y[4][
     }
     for (int l = 0; l < 4; ++l)
       if (ok >> l & 1) info[l].newton_iters += iters[l];
+    qv = qn;
+    R0k = R0v;
   }
   for (int l = 0; l < 4; ++l) {
     if (!(live >> l & 1)) continue;
@@ -1660,14 +1735,15 @@ static void main_plane4(mc_point P[4], int L, mpmc_mc_info info[4], double y[4][
 /**
  * @brief mpmc_mc_update of four points at once (return_mc.h): lane l of the block is point
  * F[l], be[l], eps_p[l], tau[l], J_out[l], info[l], err[l] (its return value), l < n <= 4.
- * The push-forward, the series Hencky strain, the elastic check's bounds, the closed-form
- * eigen-decomposition and the recomposition of b_e and tau run as batch4.h vectors, so the
- * four points' latency chains (square roots, divisions) overlap; the material at eps_p, the
- * elastic check's principal stresses where its bounds decide nothing and the principal
- * return per point.  Every lane takes mpmc_mc_update's operations (the series at its own
- * degree, the branches as masks, libm per lane), so each point gets its results to the bit
- * but for the sign of a zero (t414).  Also compiled for x86-64-v3 (mpmc_mc_update4_avx2,
- * mpmc_mc_update4_for).
+ * The push-forward, the series Hencky strain, the elastic check's bounds (and Mohr-Coulomb's
+ * softened material for it, check_mat4), the closed-form eigen-decomposition, Mohr-Coulomb's
+ * main-plane return (main_plane4) and the recomposition of b_e and tau run as batch4.h
+ * vectors, so the four points' latency chains (square roots, divisions) overlap; the elastic
+ * check's principal stresses where its bounds decide nothing, principal's set-up and its
+ * other regions per point.  Every lane takes mpmc_mc_update's operations (the series at its
+ * own degree, the branches as masks, libm per lane), so each point gets its results to the
+ * bit but for the sign of a zero (t414).  Also compiled for x86-64-v3
+ * (mpmc_mc_update4_avx2, mpmc_mc_update4_for).
  */
 void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
                                double F[][3][3], double be[][6], double *eps_p, double tau[][6],
@@ -1693,17 +1769,22 @@ void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pr
    * where they decide nothing */
   const int mc = pre->m.surface == MPMC_MC_MOHR_COULOMB;
   const int ck = mask_bits(&sm) & ~mask_bits(&sfail);
-  mc_mat q0[4];
+  mc_point P[4]; /* principal's points, their material at eps_p (P[l].S.q0) from the check */
   int elastic = 0;
   v4 sv[6], pv, trv;
   if (ck) {
     const mpmc_mc_param *m = &pre->m;
     v4 c[5];
+    int soft = 0; /* Mohr-Coulomb's lanes with a softened material: check_mat4 */
     for (int l = 0; l < 4; ++l) {
       double cl[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
-      if (ck >> l & 1) check_mat(pre, eps_p[l], &q0[l], cl);
+      if (mc && (ck >> l & 1) && !(pre->perfect || eps_p[l] == 0.0))
+        soft |= 1 << l;
+      else if (ck >> l & 1)
+        check_mat(pre, eps_p[l], &P[l].S.q0, cl);
       for (int i = 0; i < 5; ++i) c[i][l] = cl[i];
     }
+    if (soft) check_mat4(pre, eps_p, soft, P, c);
     const v4 sf = c[0], k = c[1], eta = c[2], gmax = c[3], st = c[4];
     const l4 ckm = mpmc_lane_mask[ck];
     const v4 zero = {0.0, 0.0, 0.0, 0.0};
@@ -1773,7 +1854,7 @@ void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pr
     }
     err[l] = MPMC_SUCCESS;
     for (int k = 0; k < 6; ++k) e[k] = eps[k][l];
-    if (!mc && !dp_radial(ws, solver, pre, b, e, &q0[l], be[l], &eps_p[l], tau[l], &J_out[l], inf))
+    if (!mc && !dp_radial(ws, solver, pre, b, e, &P[l].S.q0, be[l], &eps_p[l], tau[l], &J_out[l], inf))
       continue;
     eigm[l] = -1;
   }
@@ -1784,11 +1865,9 @@ void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pr
   /* the principal return per lane (return_decomposed's), its strains and stresses e, t:
    * principal's set-up per lane, Mohr-Coulomb's main plane for the lanes that try it four at
    * a time (main_plane4), the other regions per lane */
-  const v4 zero = {0.0, 0.0, 0.0, 0.0};
-  v4 ev[3] = {zero, zero, zero}, tv[3] = {zero, zero, zero};
+  v4 ev[3], tv[3];
   double epn[4], el[4][3], tl[4][3];
   mpmc_mc_info loc[4];
-  mc_point P[4];
   int done = 0, plane = 0, rest = 0;
   for (int bits = mask_bits(&eigm), l = 0; bits; bits >>= 1, ++l) {
     if (!(bits & 1)) continue;
@@ -1806,7 +1885,7 @@ void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pr
     memset(inf, 0, sizeof *inf);
     epn[l] = eps_p[l];
     int dn;
-    err[l] = principal_begin(&pre->m, etr, &epn[l], el[l], tl[l], inf, &q0[l], &P[l], &dn);
+    err[l] = principal_begin(&pre->m, etr, &epn[l], el[l], tl[l], inf, &P[l].S.q0, &P[l], &dn);
     if (err[l]) continue;
     if (dn)
       done |= 1 << l;
@@ -1842,12 +1921,11 @@ void MPMC_ISA(mpmc_mc_update4)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pr
                             &P[l]);
     if (!err[l]) done |= 1 << l;
   }
-  for (int l = 0; l < 4; ++l)
-    if (done >> l & 1)
-      for (int a = 0; a < 3; ++a) {
-        ev[a][l] = el[l][a];
-        tv[a][l] = tl[l][a];
-      }
+  for (int l = 0; l < 4; ++l) /* 0 in the lanes not done */
+    for (int a = 0; a < 3; ++a) {
+      ev[a][l] = done >> l & 1 ? el[l][a] : 0.0;
+      tv[a][l] = done >> l & 1 ? tl[l][a] : 0.0;
+    }
   if (!done) return;
   /* return_decomposed's recomposition, its operations lane by lane: b_e's eigenvalues
    * q_a.b q_a exp(2 (eps_a - eps_tr,a)) (libm's exp(2 eps_a) beyond the polynomial), b_e and

@@ -148,9 +148,10 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
 
 /* mpmc_mc_update of n <= 4 points at once, lane l the point F[l], be[l], eps_p[l], tau[l],
  * J_out[l], info[l] (info may be NULL), its return value in err[l]: the trial state, the
- * series Hencky strain and the closed-form eigen-decomposition of four points as vectors
- * (batch4.h), each point's results those of mpmc_mc_update (the frictional models' update
- * over blocks of four points, material_frictional.c). */
+ * series Hencky strain, the elastic check, the closed-form eigen-decomposition, Mohr-Coulomb's
+ * main-plane return and the recomposition of four points as vectors (batch4.h), each point's
+ * results those of mpmc_mc_update (the frictional models' update over blocks of four points,
+ * material_frictional.c). */
 void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
                      double F[][3][3], double be[][6], double *eps_p, double tau[][6],
                      double *J_out, mpmc_mc_info *info, int *err);
