@@ -244,12 +244,12 @@ static inline double dp_f(const mc_mat *q, const double s[3]) {
 /* Residuals R[0..n], the Jacobian J (may be NULL) and the stress sig (may be NULL) of a
  * region of planes at y. */
 static inline __attribute__((always_inline)) void
-eval_planes_n(const mc_sys *S, const int n, const mc_mat *q, const double *y, double *R,
-              double J[MC_NMAX][MC_NMAX], double sig[3]) {
+eval_planes_n(const mc_sys *S, const int n, const int *act, const mc_mat *q, const double *y,
+              double *R, double J[MC_NMAX][MC_NMAX], double sig[3]) {
   const mpmc_mc_param *m = S->m;
   double a[3][3], da[3][3], N[3][3], dN[3][3], k[3], dk[3], M[3] = {0, 0, 0}, dM[3] = {0, 0, 0};
   for (int j = 0; j < n; ++j) {
-    plane(S->act[j], q, a[j], da[j], N[j], dN[j], &k[j], &dk[j]);
+    plane(act[j], q, a[j], da[j], N[j], dN[j], &k[j], &dk[j]);
     for (int i = 0; i < 3; ++i) {
       M[i] += y[j] * N[j][i];
       dM[i] += y[j] * dN[j][i];
@@ -280,12 +280,19 @@ eval_planes_n(const mc_sys *S, const int n, const mc_mat *q, const double *y, do
 }
 static void eval_planes_q(const mc_sys *S, const mc_mat *q, const double *y, double *R,
                           double J[MC_NMAX][MC_NMAX], double sig[3]) {
-  eval_planes_n(S, S->n, q, y, R, J, sig);
+  eval_planes_n(S, S->n, S->act, q, y, R, J, sig);
 }
-/* the same for an edge of two planes (edge_solve): its loops of known length */
+/* the same for an edge of Mohr-Coulomb (edge_solve: S_A and S_B or S_C): its loops of known
+ * length and its planes known, so that their gradients and flows stay in registers */
 static void eval_planes_2(const mc_sys *S, const mc_mat *q, const double *y, double *R,
                           double J[MC_NMAX][MC_NMAX], double sig[3]) {
-  eval_planes_n(S, 2, q, y, R, J, sig);
+  static const int ab[2] = {S_A, S_B}, ac[2] = {S_A, S_C};
+  if (S->act[0] == S_A && S->act[1] == S_B)
+    eval_planes_n(S, 2, ab, q, y, R, J, sig);
+  else if (S->act[0] == S_A && S->act[1] == S_C)
+    eval_planes_n(S, 2, ac, q, y, R, J, sig);
+  else
+    eval_planes_n(S, 2, S->act, q, y, R, J, sig);
 }
 static void eval_planes(const mc_sys *S, const double *y, double *R, double J[MC_NMAX][MC_NMAX],
                         double sig[3]) {
