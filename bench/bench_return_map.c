@@ -19,7 +19,7 @@
  * strength, 20 % on the surface with eps_p in [0, 2]; increments 1e-4) and on an all-plastic
  * set (trial states plastic for both models); the rows give ns per point of J2's point update
  * (series path), the frictional update (mpmc_mc_update), the same four points at a time
- * (mpmc_mc_update4, the material's blocks) and its eigen path alone (mpmc_mc_return_map_eig),
+ * (mpmc_mc_update4 as a sim runs it: its AVX2 build where it can, mpmc_mc_update4_for) and its eigen path alone (mpmc_mc_return_map_eig),
  * and the ratios to J2. */
 #include <float.h>
 #include <math.h>
@@ -366,10 +366,12 @@ static int ll_states(const mpmc_mc_param *m, int set, mpmc_rm_ws *ws) {
 }
 
 /* best of 10 runs, ns per point: path 0 J2, 1 the frictional update, 2 its eigen path,
- * 3 the frictional update four points at a time (mpmc_mc_update4, the material's blocks) */
+ * 3 the frictional update four points at a time (the material's blocks, the sim's default
+ * build of mpmc_mc_update4) */
 static double ll_time(mpmc_rm_ws *ws, const mpmc_mc_param *m, int path, long *plastic) {
   mpmc_mc_pre pre;
   mpmc_mc_prepare(m, &pre);
+  const mpmc_mc_update4_fn update4 = mpmc_mc_update4_for(MPMC_KERNELS_AUTO); /* a sim's */
   double best = INFINITY, sink = 0;
   *plastic = 0;
   for (int r = 0; r < 10; ++r) {
@@ -382,7 +384,7 @@ static double ll_time(mpmc_rm_ws *ws, const mpmc_mc_param *m, int path, long *pl
         int err[4];
         memcpy(be, ll_be[i], sizeof be);
         memcpy(ep, ll_ep + i, sizeof ep);
-        mpmc_mc_update4(ws, MPMC_SOLVER_AUTO, &pre, 4, ll_F + i, be, ep, tau, J, info, err);
+        update4(ws, MPMC_SOLVER_AUTO, &pre, 4, ll_F + i, be, ep, tau, J, info, err);
         for (int l = 0; l < 4; ++l) {
           if (err[l]) {
             fprintf(stderr, "like for like, blocks, point %d: error %d\n", i + l, err[l]);

@@ -148,12 +148,24 @@ int mpmc_mc_update(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, double F[
 
 /* mpmc_mc_update of n <= 4 points at once, lane l the point F[l], be[l], eps_p[l], tau[l],
  * J_out[l], info[l] (info may be NULL), its return value in err[l]: the trial state, the
- * series Hencky strain and the closed-form eigen-decomposition of four points as vectors
- * (batch4.h), each point's results those of mpmc_mc_update (the frictional models' update
- * over blocks of four points, material_frictional.c). */
+ * series Hencky strain, the elastic check, the closed-form eigen-decomposition, Mohr-Coulomb's
+ * main-plane return and the recomposition of four points as vectors (batch4.h), each point's
+ * results those of mpmc_mc_update (the frictional models' update over blocks of four points,
+ * material_frictional.c). */
 void mpmc_mc_update4(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
                      double F[][3][3], double be[][6], double *eps_p, double tau[][6],
                      double *J_out, mpmc_mc_info *info, int *err);
+/* The same compiled for x86-64-v3 (AVX2's 256-bit vectors; ISO C's -ffp-contract=off, so
+ * the same bits), in builds with the AVX2 kernels (MPMC_KERNEL_DISPATCH, CMakeLists.txt). */
+void mpmc_mc_update4_avx2(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
+                          double F[][3][3], double be[][6], double *eps_p, double tau[][6],
+                          double *J_out, mpmc_mc_info *info, int *err);
+typedef void (*mpmc_mc_update4_fn)(mpmc_rm_ws *ws, int solver, const mpmc_mc_pre *pre, int n,
+                                   double F[][3][3], double be[][6], double *eps_p,
+                                   double tau[][6], double *J_out, mpmc_mc_info *info, int *err);
+/* The block update a sim of kernel set kernels (MPMC_KERNELS_*) runs: the AVX2 one where
+ * the build has it, the processor runs it and kernels is not MPMC_KERNELS_BASELINE. */
+mpmc_mc_update4_fn mpmc_mc_update4_for(int kernels);
 
 void mpmc_mc_reduce(mpmc_mc_param *m, double factor);
 
