@@ -32,6 +32,7 @@
 #include <time.h>
 
 #include "mpmc.h"
+#include "bench_util.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -42,12 +43,6 @@ typedef struct {
   double size, rate, ramp, delta, damping, cfl, flip, mu, dhat, kappa;
   const char *csv;
 } opts;
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 #define CALL(expr)                                                                       \
   do {                                                                                   \

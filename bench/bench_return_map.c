@@ -27,28 +27,11 @@
 #include <string.h>
 #include <time.h>
 
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
-
 #include "j2_cases.h" /* tests/: the stiff/extreme table, shared with t403 */
 #include "linalg.h"
 #include "return_map.h"
 #include "return_mc.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static unsigned long long rng = 88172645463325252ull;
-static double urand(void) {
-  rng ^= rng >> 12;
-  rng ^= rng << 25;
-  rng ^= rng >> 27;
-  return (double)((rng * 2685821657736338717ull) >> 11) * 0x1.0p-53;
-}
+#include "bench_util.h"
 
 #define NS 20000
 static double be0[NS][6], ep0[NS], Fs[NS][3][3];
@@ -253,7 +236,7 @@ static int timing_mc(void) {
                 {"Drucker-Prager (compression), softening", MPMC_DP_COMPRESSION, 1}};
   for (int k = 0; k < 3; ++k) {
     const mpmc_mc_param m = mc_soil(models[k].surface, models[k].soft);
-    rng = 88172645463325252ull;
+    rng_state = TEST_RNG_SEED;
     const mpmc_j2_param lm = landslide();
     make_states(&lm); /* the same increments Fs as J2's */
     mc_states(&m);
@@ -437,7 +420,7 @@ static int timing_like(void) {
   for (int set = 0; set < 2; ++set)
     for (int k = 0; k < 3; ++k) {
       const mpmc_mc_param m = mc_soil(models[k].surface, models[k].soft);
-      rng = 88172645463325252ull;
+      rng_state = TEST_RNG_SEED;
       /* the states come from Mohr-Coulomb's strength: the same b_e, eps_p, F for every row */
       const mpmc_mc_param mmc = mc_soil(MPMC_MC_MOHR_COULOMB, models[k].soft);
       if (ll_states(&mmc, set, ws)) {

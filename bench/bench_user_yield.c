@@ -11,27 +11,10 @@
 #include <string.h>
 #include <time.h>
 
-#ifndef M_PI
-#define M_PI 3.14159265358979323846
-#endif
-
 #include "linalg.h"
 #include "return_cpp.h"
 #include "return_map.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static unsigned long long rng = 88172645463325252ull;
-static double urand(void) {
-  rng ^= rng >> 12;
-  rng ^= rng << 25;
-  rng ^= rng >> 27;
-  return (double)((rng * 2685821657736338717ull) >> 11) * 0x1.0p-53;
-}
+#include "bench_util.h"
 
 /* J2 with exponential softening as a user surface (tests/t415's, without its faults) */
 static int j2_fn(void *data, const double *tau, double alpha, mpmc_yield_eval *out) {
