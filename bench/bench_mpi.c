@@ -118,7 +118,7 @@ int MPI_Waitall(int n, MPI_Request reqs[], MPI_Status *statuses) {
 
 /* ---- one run ------------------------------------------------------------------------- */
 
-#define HALO_PLANES 5 /* mpi.c's halo: node planes b - 2 .. b + 2 around each cut b */
+#define HALO_PLANES 3 /* mpi.c's halo: node planes b - 1 .. b + 1 around each cut b */
 
 typedef struct {
   double seconds;                           /* wall time of the timed steps (rank 0's)  */
@@ -135,6 +135,8 @@ typedef struct {
                                                and F-bar's sum                            */
   double grid_node_bytes;                   /* bytes the grid holds per node: those and
                                                the fixed flags                            */
+  long held_max, whole;                     /* grid nodes held: the most on a rank; the
+                                               whole grid's                               */
 } result;
 
 static int my_rank;
@@ -218,6 +220,11 @@ static result run(MPI_Comm comm, int centred, int threads, int steps) {
   r.neighbours = (rank > 0) + (rank + 1 < nranks);
   r.rec_bytes = rec_bytes;
   r.grid_node_bytes = node_bytes;
+  size_t held, whole;
+  CHECK(mpmc_bench_grid_held(sim, &held, &whole));
+  const long lh = (long)held;
+  MPI_Allreduce(&lh, &r.held_max, 1, MPI_LONG, MPI_MAX, comm);
+  r.whole = (long)whole;
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   return r;
@@ -260,6 +267,15 @@ static double halo_faces(const double *ext, const int *p, int planes, int *msgs)
   return nodes;
 }
 
+/* The nodes a rank holds for sub-domains of ext[3] cells on a p[3] grid of ranks in a cube
+ * of N cells a side: a cut axis its cells' nodes and ghost planes beyond each cut (mpi.c,
+ * hold_slab), an axis not cut the whole grid's nodes. */
+static double held_nodes(double N, const double *ext, const int *p, int ghost) {
+  double n = 1.0;
+  for (int a = 0; a < 3; ++a) n *= (p[a] > 1 ? ext[a] : N) + 2.0 * ghost + 1.0;
+  return n;
+}
+
 static int ilog2ceil(int n) {
   int k = 0;
   while ((1 << k) < n) ++k;
@@ -290,6 +306,8 @@ static void model(const result *one, const result *two, int steps) {
   printf("  2 ranks: halo %.0f B/step/rank over a cross-section of %ld nodes: %.1f B per "
          "cross-section node and step, %.2f planes of %.0f B (the node record and F-bar's sum)\n",
          two->bytes[K_HALO], two->area, barea, barea / two->rec_bytes, two->rec_bytes);
+  printf("  grid nodes held, the most on a rank: %ld of the whole grid's %ld (%.0f %%)\n",
+         two->held_max, two->whole, 100.0 * two->held_max / two->whole);
   printf("  messages per neighbour and step: %.2f (halo %.2f, migration %.2f); migration %.0f "
          "B/step; collectives per step: %.2f allreduce, %.2f allgather (%.0f B each), %.2f bcast\n",
          mnb, two->msgs[K_HALO] / nb, two->msgs[K_MIGRATE] / nb, mig, nar, nag, bag, nbc);
@@ -333,15 +351,16 @@ static void model(const result *one, const result *two, int steps) {
       printf("%-6d %-7s %-17s %5.1f %8.2f %8.2f %7.0f%% %5.0f %8.1f %7.3f %7.3f %6.2f%% %6.2f%% "
              "%7.2f%s\n", P, dname[d], sub, emin, hbytes / 1e6, owned / 1e6, 100 * hbytes / owned,
              mtot, 1e3 * comp, 1e3 * comm[0], 1e3 * comm[1], 100 * eff[0], 100 * eff[1],
-             pow(N + 2 * ghost + 1, 3) * gnode / 1e9,
+             held_nodes(N, ext, p, ghost) * gnode / 1e9,
              emin < min_cells ? "  thinner than 5 cells" : "");
     }
   }
   printf("(min: the thinnest cut extent in cells, against the slabs' minimum of %d; halo/own: the "
          "halo bytes a rank sends per step over its owned grid's bytes; msgs: messages sent per "
-         "step; comm A, B: ms per step; grid GB: what every rank allocates today, the global "
-         "grid)\n",
-         min_cells);
+         "step; comm A, B: ms per step; grid GB: the grid a rank holds, its sub-domain's nodes "
+         "and %d ghost planes beyond each cut, the whole grid along axes not cut; the whole "
+         "grid is %.2f GB at 1,024 ranks)\n",
+         min_cells, ghost, pow(cbrt(cells * 1024) + 2 * ghost + 1, 3) * gnode / 1e9);
   /* a slab w cells thick sends 2 x barea per node of its cross-section and owns w x gnode */
   const double w10 = ceil(20.0 * barea / gnode), w3 = ceil(20.0 * 3.0 * two->rec_bytes / gnode);
   printf("slabs: halo/own = 2 x %.0f B / (w x %.0f B) whatever the cross-section: <= 10 %% needs "
@@ -413,6 +432,7 @@ int main(int argc, char **argv) {
              sc ? "centred" : "column", size, threads, r.points, steps, 1e3 * r.seconds / steps,
              1e3 * r.outside / steps, 1e3 * r.cpu_max / steps, 1e3 * r.cpu_sum / steps,
              (double)r.points * steps / r.seconds / 1e6, r.pmin, r.pmax);
+      printf(" grid_nodes_held=%ld grid_nodes=%ld", r.held_max, r.whole);
       for (int k = 0; k < K_COUNT; ++k)
         if (k != K_P2P) /* halo + migration */
           printf(" %s_B=%.0f %s_msgs=%.2f", kind_name[k], r.bytes[k], kind_name[k], r.msgs[k]);

@@ -150,16 +150,21 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
       for (int q = 0; q < ns->n; ++q) {
         const int *c = ns->idx + (size_t)q * sim->cfg.dim;
         size_t node = 0;
-        for (int a = sim->cfg.dim - 1; a >= 0; --a) node = node * (size_t)g->n[a] + (size_t)(c[a] + MPMC_GHOST);
-        g->fixed[node] |= bits;
+        int held = 1; /* over MPI a rank holds only its slab's nodes (grid.off) */
+        for (int a = sim->cfg.dim - 1; a >= 0; --a) {
+          const int i = c[a] + MPMC_GHOST - g->off[a];
+          held &= i >= 0 && i < g->n[a];
+          node = node * (size_t)g->n[a] + (size_t)i;
+        }
+        if (held) g->fixed[node] |= bits;
       }
       continue;
     }
     int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < sim->cfg.dim; ++a) {
       const double l = (w->lo[a] - g->origin[a]) * g->inv_h, u = (w->hi[a] - g->origin[a]) * g->inv_h;
-      lo[a] = isinf(l) ? 0 : (int)ceil(l - tol * g->inv_h);
-      hi[a] = isinf(u) ? g->n[a] - 1 : (int)floor(u + tol * g->inv_h);
+      lo[a] = isinf(l) ? 0 : (int)ceil(l - tol * g->inv_h) - g->off[a]; /* the held nodes' */
+      hi[a] = isinf(u) ? g->n[a] - 1 : (int)floor(u + tol * g->inv_h) - g->off[a];
       if (lo[a] < 0) lo[a] = 0;
       if (hi[a] > g->n[a] - 1) hi[a] = g->n[a] - 1;
     }
@@ -177,7 +182,7 @@ int mpmc_boundary_apply_flags(mpmc_sim sim) {
       mpmc_mirror *m = &sim->scr.mirrors[sim->scr.nmirror++];
       m->axis = w->axis;
       m->side = w->side;
-      m->plane = (int)round(s);
+      m->plane = (int)round(s) - g->off[w->axis]; /* held node index (may lie outside) */
       m->odd = w->kind == MPMC_WALL_FIXED ? 7u : 1u << w->axis;
     }
   }

@@ -154,21 +154,25 @@ static int select_rows(hid_t g, mpmc_sim sim, ckpt_rows *k) {
 
 /* ---- block: configuration, grid, time, statistics ----------------------------------------- */
 
-/* Adaptive damping's node store as one array: in one process the rank's own; over MPI each
- * node from the rank whose slab holds its plane (damping.c: a node with mass last step holds
- * the same values on every rank that has it), the others' zero, summed over the ranks.  A
- * restart on any number of ranks then finds every node's last force.  NULL: no memory. */
+/* Adaptive damping's node store as one array over the whole grid: in one process the rank's
+ * own; over MPI each node from the rank whose slab holds its plane (damping.c: a node with
+ * mass last step holds the same values on every rank that has it), the others' -0, summed
+ * over the ranks.  A restart on any number of ranks then finds every node's last force.
+ * NULL: no memory. */
 static double *adaptive_nodes(mpmc_const_sim sim) {
   if (!sim->dd || sim->adr_own[0] < 0) return sim->adr_f;
-  double *a = malloc(sim->adr_nf * sizeof *a);
-  if (!a) return NULL;
   const int ax = sim->adr_own[0], w = 1 + sim->cfg.dim;
+  const size_t all = mpmc_grid_global_nodes(&sim->grid) * (size_t)w;
+  double *a = malloc(all * sizeof *a);
+  if (!a) return NULL;
+  for (size_t k = 0; k < all; ++k) a[k] = -0.0; /* -0 + x = x for every x, -0 and +0 too */
   for (size_t i = 0; i < sim->grid.nn; ++i) {
     const long k = mpmc_grid_plane(&sim->grid, ax, i);
-    const int mine = k >= sim->adr_own[1] && k < sim->adr_own[2];
-    for (int c = 0; c < w; ++c) a[i * (size_t)w + c] = mine ? sim->adr_f[i * (size_t)w + c] : 0.0;
+    if (k < sim->adr_own[1] || k >= sim->adr_own[2]) continue;
+    memcpy(a + mpmc_grid_global(&sim->grid, i) * (size_t)w, sim->adr_f + i * (size_t)w,
+           sizeof(double) * (size_t)w);
   }
-  mpmc_dd_sum(sim, a, (int)sim->adr_nf); /* x + 0: the owner's values, exactly */
+  mpmc_dd_sum_disjoint(sim, a, all); /* x + -0: the owner's values, exactly */
   return a;
 }
 
@@ -204,7 +208,8 @@ static int write_config(hid_t f, mpmc_const_sim sim) {
     double *nodes = adaptive_nodes(sim);
     if (!nodes) return -1;
     st |= mpmc_h5_dataset_write(g, "adaptive_damping_nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                                sim->grid.nn, (size_t)(1 + sim->cfg.dim), nodes);
+                                mpmc_grid_global_nodes(&sim->grid), (size_t)(1 + sim->cfg.dim),
+                                nodes);
     if (nodes != sim->adr_f) free(nodes);
   }
   st |= mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &sim->time);
@@ -274,22 +279,29 @@ static int read_water_table(hid_t f, mpmc_sim sim) {
 }
 
 /* Adaptive damping's node store (config dataset adaptive_damping_nodes [nn][1 + dim], the
- * grid's nn; absent: the next step measures no quotient). */
+ * whole grid's nn, of which a rank keeps its held nodes; absent: the next step measures no
+ * quotient). */
 static int read_adaptive_nodes(hid_t f, mpmc_sim sim) {
   hid_t g = H5Gopen2(f, "config", H5P_DEFAULT);
   if (g < 0) return MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT, "checkpoint has no /config group");
   int err = MPMC_SUCCESS;
   if (exists(g, "adaptive_damping_nodes")) {
-    const size_t cols = (size_t)(1 + sim->cfg.dim), n = sim->grid.nn * cols;
-    double *a = malloc(n * sizeof *a);
+    const size_t cols = (size_t)(1 + sim->cfg.dim), all = mpmc_grid_global_nodes(&sim->grid),
+                 n = sim->grid.nn * cols;
+    double *a = malloc(all * cols * sizeof *a);
     if (!a)
       err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate adaptive damping's node store");
-    else if (read_dataset(g, "adaptive_damping_nodes", H5T_NATIVE_DOUBLE, sim->grid.nn, cols,
-                          a) < 0)
+    else if (read_dataset(g, "adaptive_damping_nodes", H5T_NATIVE_DOUBLE, all, cols, a) < 0)
       err = MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT,
                        "checkpoint /config: adaptive_damping_nodes is not [%zu][%zu] (the grid's "
                        "nodes)",
-                       sim->grid.nn, cols);
+                       all, cols);
+    if (!err && n != all * cols) { /* over MPI: the rank's held nodes alone */
+      for (size_t i = 0; i < sim->grid.nn; ++i)
+        memmove(a + i * cols, a + mpmc_grid_global(&sim->grid, i) * cols, cols * sizeof *a);
+      double *s = realloc(a, n * sizeof *a);
+      a = s ? s : a;
+    }
     if (err) {
       free(a);
     } else {

@@ -77,12 +77,14 @@ int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow) {
   sim->adr_own[0] = -1;
 #ifdef MPMC_HAVE_MPI
   /* over MPI a halo node holds the same sums on both ranks (mpi.c): it counts on the rank
-   * whose slab holds the cell above it, the top plane on the last rank */
+   * whose slab holds the cell above it, the top plane on the last rank; planes of the held
+   * nodes (grid.off) */
   int rank, nranks, axis, lo, hi;
   if (sim->dd && !mpmc_sim_get_mpi_slab(sim, &rank, &nranks, &axis, &lo, &hi)) {
+    const int off = sim->grid.off[axis]; /* the held nodes' planes */
     sim->adr_own[0] = axis;
-    sim->adr_own[1] = lo;
-    sim->adr_own[2] = rank == nranks - 1 ? sim->grid.n[axis] : hi;
+    sim->adr_own[1] = lo - off;
+    sim->adr_own[2] = (rank == nranks - 1 ? sim->grid.ng[axis] : hi) - off;
   }
 #endif
   return MPMC_SUCCESS;

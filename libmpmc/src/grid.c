@@ -27,7 +27,7 @@ int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, c
   g->h = h;
   g->inv_h = 1.0 / h;
   for (int a = 0; a < 3; ++a) {
-    g->n[a] = n[a];
+    g->n[a] = g->ng[a] = n[a];
     g->lo[a] = a < dim ? lo[a] : 0.0;
     g->hi[a] = a < dim ? lo[a] + (n[a] - 1 - 2 * MPMC_GHOST) * h : 0.0;
     g->origin[a] = a < dim ? lo[a] - MPMC_GHOST * h : 0.0;
@@ -35,6 +35,20 @@ int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, c
   g->nn = nn;
   g->valid = 1;
   return MPMC_SUCCESS;
+}
+
+int mpmc_grid_span(mpmc_grid *g, int a, int lo, int hi) {
+  lo = lo < 0 ? 0 : lo;
+  hi = hi > g->ng[a] - 1 ? g->ng[a] - 1 : hi;
+  if (lo == g->off[a] && hi - lo + 1 == g->n[a]) return 0;
+  mpmc_grid_free(g); /* the arrays' layout changes: mpmc_grid_alloc makes them anew */
+  g->off[a] = lo;
+  g->n[a] = hi - lo + 1;
+  g->nn = (size_t)g->n[0] * (size_t)g->n[1] * (size_t)g->n[2];
+  g->lin = g->off[0] + (long long)g->n[0] * (g->off[1] + (long long)g->n[1] * g->off[2]);
+  for (int b = 0; b < 3; ++b) g->act_lo[b] = g->act_hi[b] = 0; /* nothing scattered yet */
+  g->rows_skip = 0;
+  return 1;
 }
 
 /* Zeroed, 64-byte aligned (a node record is then one cache line); nothing if *a is set. */

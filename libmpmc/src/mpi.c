@@ -59,6 +59,9 @@ int mpmc_dd_setup(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
 int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) { return (void)sim, (void)x, 1; }
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
+void mpmc_dd_sum_disjoint(const struct mpmc_sim_s *sim, double *v, size_t n) {
+  (void)sim, (void)v, (void)n;
+}
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) { return (void)sim, (void)v, 1; }
 void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id) { (void)sim, (void)v, (void)id; }
 void mpmc_dd_free(struct mpmc_sim_s *sim) { (void)sim; }
@@ -189,15 +192,49 @@ void mpmc_dd_free(struct mpmc_sim_s *sim) {
   sim->dd = NULL;
 }
 
-/* The slabs of the grid just set (mpmc_sim_set_grid). */
+/* The grid's nodes this rank holds: its slab's cells' nodes and MPMC_GHOST planes either
+ * side (the stencils reach one plane below a slab and two above its last cell; the halo
+ * sums and the mirrored walls' folds stay within them).  When they change the grid's and
+ * F-bar's node arrays are made anew at the next mpmc_sim_prepare, and adaptive damping's
+ * node store keeps the planes held before and after. */
+static int hold_slab(struct mpmc_sim_s *sim) {
+  const struct mpmc_dd_s *dd = sim->dd;
+  mpmc_grid *g = &sim->grid;
+  const int ax = dd->axis, w = 1 + sim->cfg.dim;
+  const mpmc_grid old = *g;
+  if (!mpmc_grid_span(g, ax, dd->cut[dd->rank] - MPMC_GHOST, dd->cut[dd->rank + 1] + MPMC_GHOST))
+    return MPMC_SUCCESS;
+  sim->fb.nn = 0; /* F-bar's sums anew (fbar.c, mpmc_fbar_prepare) */
+  sim->scr.prepared = 0;
+  sim->scr.walls_dirty = 1;
+  if (!sim->adr_nf) return MPMC_SUCCESS;
+  const size_t need = g->nn * (size_t)w;
+  double *f = malloc(need * sizeof *f);
+  MPMC_CHECK(f, sim->ctx, MPMC_ERR_MEMORY, "cannot allocate adaptive damping's node store");
+  for (size_t i = 0; i < g->nn; ++i) { /* -2: no mass in the last step (damping.c) */
+    long c[3]; /* node i's indices among the nodes held before */
+    for (int a = 0; a < 3; ++a) c[a] = mpmc_grid_plane(g, a, i) + g->off[a] - old.off[a];
+    if (c[ax] >= 0 && c[ax] < old.n[ax]) {
+      const size_t o = (size_t)c[0] + (size_t)old.n[0] * ((size_t)c[1] + (size_t)old.n[1] * (size_t)c[2]);
+      memcpy(f + i * (size_t)w, sim->adr_f + o * (size_t)w, sizeof(double) * (size_t)w);
+    } else
+      for (int c = 0; c < w; ++c) f[i * (size_t)w + c] = -2.0;
+  }
+  free(sim->adr_f);
+  sim->adr_f = f;
+  sim->adr_nf = need;
+  return MPMC_SUCCESS;
+}
+
+/* The slabs of the grid just set (mpmc_sim_set_grid), and the nodes this rank holds. */
 int mpmc_dd_setup(struct mpmc_sim_s *sim) {
   struct mpmc_dd_s *dd = sim->dd;
   if (!dd) return MPMC_SUCCESS;
   const mpmc_grid *g = &sim->grid;
   int ax = sim->cfg.dim - 1;
   for (int a = sim->cfg.dim - 2; a >= 0; --a)
-    if (g->n[a] > g->n[ax]) ax = a;
-  const int cells = g->n[ax] - 1;
+    if (g->ng[a] > g->ng[ax]) ax = a;
+  const int cells = g->ng[ax] - 1;
   MPMC_CHECK(cells >= MPMC_DD_MIN_CELLS * dd->size, sim->ctx, MPMC_ERR_ARG,
              "the grid has %d cells (ghost layers included) along its longest axis %d: too few "
              "for %d ranks, whose slabs need %d cells each; use at most %d ranks or a finer grid",
@@ -207,15 +244,16 @@ int mpmc_dd_setup(struct mpmc_sim_s *sim) {
   for (int r = 0; r <= dd->size; ++r) cut[r] = (int)((long long)cells * r / dd->size);
   dd->cut = cut;
   dd->axis = ax;
-  return MPMC_SUCCESS;
+  return hold_slab(sim);
 }
 
-/* The cell of position x along the slab axis, clamped to the grid (as p2g.c's count_chunk). */
+/* The global cell of position x along the slab axis, clamped to the grid (as p2g.c's
+ * count_chunk). */
 static int slab_cell(const struct mpmc_sim_s *sim, const double *x) {
   const mpmc_grid *g = &sim->grid;
   const int ax = sim->dd->axis;
   const double s = (x[ax] - g->origin[ax]) * g->inv_h;
-  return s >= 0.0 ? (s < g->n[ax] - 1 ? (int)s : g->n[ax] - 2) : 0;
+  return s >= 0.0 ? (s < g->ng[ax] - 1 ? (int)s : g->ng[ax] - 2) : 0;
 }
 
 /* The rank whose slab holds cell c. */
@@ -300,6 +338,14 @@ void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) {
   MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, sim->dd->comm);
 }
 
+void mpmc_dd_sum_disjoint(const struct mpmc_sim_s *sim, double *v, size_t n) {
+  if (!sim->dd) return;
+  for (size_t k = 0; k < n; k += INT_MAX / 2) { /* MPI counts are ints */
+    const size_t len = n - k < INT_MAX / 2 ? n - k : INT_MAX / 2;
+    MPI_Allreduce(MPI_IN_PLACE, v + k, (int)len, MPI_DOUBLE, MPI_SUM, sim->dd->comm);
+  }
+}
+
 /* 1 on the lowest rank whose v is the largest over the ranks, 0 on the others. */
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) {
   const struct mpmc_dd_s *dd = sim->dd;
@@ -373,7 +419,7 @@ static void grow_box(mpmc_grid *g, const int *lo, const int *hi) {
  * into lo/hi; 0 if empty. */
 static int halo_box(const struct mpmc_sim_s *sim, int r, int *lo, int *hi) {
   const mpmc_grid *g = &sim->grid;
-  const int ax = sim->dd->axis, b = sim->dd->cut[r];
+  const int ax = sim->dd->axis, b = sim->dd->cut[r] - g->off[ax]; /* the held nodes' */
   int empty = 0;
   for (int a = 0; a < 3; ++a) {
     lo[a] = g->act_lo[a];
@@ -387,12 +433,13 @@ static int halo_box(const struct mpmc_sim_s *sim, int r, int *lo, int *hi) {
   return !empty;
 }
 
-/* Pack the box [lo, hi) of arr (width doubles per node) after a header of the box. */
+/* Pack the box [lo, hi) of arr (width doubles per node) after a header of the box (in
+ * global node indices: the neighbour holds other nodes). */
 static size_t pack(const mpmc_grid *g, const double *arr, int width, int ok, const int *lo,
                    const int *hi, double *out) {
   for (int a = 0; a < 3; ++a) {
-    out[a] = ok ? lo[a] : 0;
-    out[3 + a] = ok ? hi[a] : 0;
+    out[a] = ok ? lo[a] + g->off[a] : 0;
+    out[3 + a] = ok ? hi[a] + g->off[a] : 0;
   }
   size_t k = 6;
   if (!ok) return k;
@@ -410,8 +457,8 @@ static size_t pack(const mpmc_grid *g, const double *arr, int width, int ok, con
 static void unpack_add(mpmc_grid *g, double *arr, int width, const double *in) {
   int lo[3], hi[3], empty = 0;
   for (int a = 0; a < 3; ++a) {
-    lo[a] = (int)in[a];
-    hi[a] = (int)in[3 + a];
+    lo[a] = (int)in[a] - g->off[a];
+    hi[a] = (int)in[3 + a] - g->off[a];
     empty |= hi[a] <= lo[a];
   }
   if (empty) return;
@@ -436,14 +483,15 @@ static int check_mirrors(struct mpmc_sim_s *sim) {
   for (int w = 0; w < sim->scr.nmirror; ++w) {
     const mpmc_mirror *m = &sim->scr.mirrors[w];
     if (m->axis != dd->axis) continue;
+    const int plane = m->plane + sim->grid.off[m->axis]; /* global, as the cuts */
     for (int r = 1; r < dd->size; ++r) {
       const int b = dd->cut[r];
-      MPMC_CHECK(m->plane + MPMC_GHOST < b - 1 || m->plane - MPMC_GHOST > b + 1, sim->ctx,
+      MPMC_CHECK(plane + MPMC_GHOST < b - 1 || plane - MPMC_GHOST > b + 1, sim->ctx,
                  MPMC_ERR_UNSUPPORTED,
                  "a wall on node plane %d of axis %d lies within %d cells of the cut between "
                  "ranks %d and %d (cell %d): walls so close to a slab boundary are not supported "
                  "over MPI yet; use another number of ranks",
-                 m->plane, m->axis, MPMC_GHOST + 1, r - 1, r, b);
+                 plane, m->axis, MPMC_GHOST + 1, r - 1, r, b);
     }
   }
   return MPMC_SUCCESS;
@@ -881,8 +929,9 @@ static int clear_of_mirrors(const struct mpmc_sim_s *sim, int c, int lo, int hi)
     int moved = 0;
     for (int w = 0; w < sim->scr.nmirror; ++w) {
       const mpmc_mirror *m = &sim->scr.mirrors[w];
-      if (m->axis != sim->dd->axis || c < m->plane - reach || c > m->plane + reach) continue;
-      const int below = m->plane - reach - 1, above = m->plane + reach + 1;
+      const int plane = m->plane + sim->grid.off[m->axis]; /* global, as the cuts */
+      if (m->axis != sim->dd->axis || c < plane - reach || c > plane + reach) continue;
+      const int below = plane - reach - 1, above = plane + reach + 1;
       const int okb = below >= lo && below <= hi, oka = above >= lo && above <= hi;
       if (!okb && !oka) return -1;
       c = okb && (!oka || c - below <= above - c) ? below : above;
@@ -931,7 +980,10 @@ static int balance(struct mpmc_sim_s *sim) {
   free(nc);
   if (!ok || same) return MPMC_SUCCESS; /* no better cuts (or none the walls allow) */
   dd->bal_count++;
-  return migrate(sim, 1);
+  err = hold_slab(sim); /* the new slab's nodes, made before the step's phases */
+  if (!err) err = mpmc_sim_prepare(sim);
+  err = mpmc_dd_agree(sim, err);
+  return err ? err : migrate(sim, 1);
 }
 
 /* Before a step: balance if due (mpmc_sim_set_mpi_balance; collective). */

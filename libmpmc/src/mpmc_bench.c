@@ -12,6 +12,13 @@ int mpmc_bench_grid(mpmc_sim sim, int lo[3], int hi[3], size_t *record_bytes, si
   return MPMC_SUCCESS;
 }
 
+int mpmc_bench_grid_held(mpmc_sim sim, size_t *held, size_t *whole) {
+  if (!sim) return MPMC_ERR_ARG;
+  *held = sim->grid.nn;
+  *whole = mpmc_grid_global_nodes(&sim->grid);
+  return MPMC_SUCCESS;
+}
+
 void mpmc_bench_layout(int *ghost_cells, int *min_slab_cells) {
   *ghost_cells = MPMC_GHOST;
   *min_slab_cells = MPMC_DD_MIN_CELLS;

@@ -22,6 +22,9 @@ double mpmc_bench_bytes_per_point(mpmc_sim sim);
  * (mass, momentum, force and F-bar's nodal sums, as the halo sends it) and that with its wall
  * flags.  0, or MPMC_ERR_ARG for NULL. */
 int mpmc_bench_grid(mpmc_sim sim, int lo[3], int hi[3], size_t *record_bytes, size_t *node_bytes);
+/* The grid nodes this rank holds (over MPI its slab's and MPMC_GHOST planes beyond each cut)
+ * and the whole grid's.  0, or MPMC_ERR_ARG for NULL. */
+int mpmc_bench_grid_held(mpmc_sim sim, size_t *held, size_t *whole);
 /* The ghost cells the grid adds beyond the box on each side, and the fewest cells an MPI slab
  * may have. */
 void mpmc_bench_layout(int *ghost_cells, int *min_slab_cells);

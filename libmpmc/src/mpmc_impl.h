@@ -119,9 +119,17 @@ typedef struct {
   int dim;
   double lo[3], hi[3]; /* user box                                                */
   double h, inv_h;
-  double origin[3];    /* position of node 0 (lo - GHOST*h)                        */
-  int n[3];            /* nodes per axis (1 in unused axes)                         */
-  size_t nn;           /* total nodes                                              */
+  double origin[3];    /* position of global node 0 (lo - GHOST*h)                 */
+  int ng[3];           /* the whole grid's nodes per axis (1 in unused axes)        */
+  /* The nodes held: n[a] per axis from global node off[a] (over MPI a rank holds only its
+   * slab and halo along the slab axis: mpmc_grid_span; else off = 0, n = ng).  Node
+   * indices are the held ones' everywhere: positions give global indices (origin), from
+   * which off is subtracted exactly, so a held node has the same weights as in one process;
+   * a linear index is the global formula with the held dims minus lin. */
+  int n[3];            /* nodes held per axis                                       */
+  int off[3];          /* global index of the first node held per axis              */
+  size_t nn;           /* nodes held                                                */
+  long long lin;       /* off[0] + n[0] (off[1] + n[1] off[2])                       */
   double *node;        /* [nn][MPMC_NREC] mass, momentum, f_int + f_ext (slots above), with
                           F-bar's paper, total and anchored forms sum w V^n in MPMC_VSLOT; after the
                           grid update mass, new velocity, velocity increment            */
@@ -155,6 +163,21 @@ typedef struct {
 int mpmc_grid_setup(mpmc_context ctx, mpmc_grid *g, int dim, const double *lo, const double *hi,
                     double h);
 int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g);
+/* Hold only the global nodes [lo, hi] along axis a (clipped to the grid; the other axes
+ * whole): frees the node arrays when the span changes (mpmc_grid_alloc makes them anew) and
+ * returns 1, else 0.  Over MPI (mpi.c) a rank's slab and halo. */
+int mpmc_grid_span(mpmc_grid *g, int a, int lo, int hi);
+/* the whole grid's index of held node i */
+static inline size_t mpmc_grid_global(const mpmc_grid *g, size_t i) {
+  const size_t n0 = (size_t)g->n[0], n1 = (size_t)g->n[1];
+  const size_t x = i % n0 + (size_t)g->off[0], y = i / n0 % n1 + (size_t)g->off[1],
+               z = i / (n0 * n1) + (size_t)g->off[2];
+  return x + (size_t)g->ng[0] * (y + (size_t)g->ng[1] * z);
+}
+/* the whole grid's nodes */
+static inline size_t mpmc_grid_global_nodes(const mpmc_grid *g) {
+  return (size_t)g->ng[0] * (size_t)g->ng[1] * (size_t)g->ng[2];
+}
 /* *a: n zeroed doubles, 64-byte aligned (unless *a is set already) */
 int mpmc_grid_array(mpmc_context ctx, double **a, size_t n);
 /* zero the whole grid (every node active) */
@@ -368,7 +391,7 @@ typedef struct {
  * mirror image of the velocities inside (odd for constrained components, even for free
  * ones), so that B-splines see a wall at the plane instead of a clamped layer of ghosts. */
 typedef struct {
-  int axis, side, plane; /* plane: node index of the wall along axis */
+  int axis, side, plane; /* plane: held node index of the wall along axis (grid.off) */
   unsigned odd;          /* bit a: component a is reflected with a sign change */
 } mpmc_mirror;
 
@@ -493,9 +516,9 @@ struct mpmc_sim_s {
    * grid's force change over the velocity, smoothed as num / den of running sums */
   double adr_c;       /* the damping coefficient c [1/s] the next grid update applies   */
   double adr_sum[2];  /* running sums of v.(f^{n-1} - f^n) and dt m v.v (the quotient)  */
-  double *adr_f;      /* [grid nn][1 + dim]: the step a node last held mass, its force then */
+  double *adr_f;      /* [grid nn][1 + dim] (the held nodes): the step a node last held mass, its force then */
   size_t adr_nf;      /* doubles in adr_f (0: none)                                     */
-  int adr_own[3];     /* over MPI: the slab axis and the node planes [lo, hi) along it whose
+  int adr_own[3];     /* over MPI: the slab axis and the held node planes [lo, hi) whose
                        * nodes this rank adds to the sums (each halo node once); axis -1: all */
   int64_t sort_last;  /* step count at the last sort; -1: none yet (sort.c)             */
   int sort_axis;      /* the slab axis the last sort put outermost; -1: none            */
@@ -657,6 +680,9 @@ int mpmc_dd_balance_due(struct mpmc_sim_s *sim);
 /* v[0 .. n) summed over the ranks in rank order (the same bits on every rank) / maximum */
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n);
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n);
+/* v[0 .. n) summed over the ranks where at most one rank holds a nonzero value per entry
+ * (x + 0 = x in any order: the same bits without mpmc_dd_sum's gather of every rank's v) */
+void mpmc_dd_sum_disjoint(const struct mpmc_sim_s *sim, double *v, size_t n);
 /* 1 on the (lowest) rank whose v is the largest */
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v);
 /* the least v over the ranks and, of the ranks that have it, the least id (collective);

@@ -29,7 +29,7 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const int ROWS, const mpmc_gr
 #if defined(__AVX2__) /* the axes in the lanes of one vector: the same operations per lane */
   const __m256i in = _mm256_set_epi64x(0, DIM == 3 ? -1 : 0, -1, -1); /* the point's axes */
   const __m256d ov = _mm256_set_pd(0.0, o[2], o[1], o[0]), ihv = _mm256_set1_pd(ih);
-  const __m128i axv = _mm_set1_epi32(ax);
+  const __m128i axv = _mm_set1_epi32(ax), offv = _mm_set_epi32(0, g->off[2], g->off[1], g->off[0]);
   __m128i lov = _mm_set1_epi32(INT_MAX), hiv = _mm_set1_epi32(-1);
 #endif
   int cur = -1, run = 0; /* runs of one plane (sorted points) counted in a register */
@@ -38,8 +38,9 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const int ROWS, const mpmc_gr
   for (int q = q0; q < q1; ++q) {
     const double *x = xs + (size_t)q * DIM;
 #if defined(__AVX2__)
-    const __m128i cv = _mm256_cvttpd_epi32(
-        _mm256_mul_pd(_mm256_sub_pd(_mm256_maskload_pd(x, in), ov), ihv));
+    const __m128i cv = _mm_sub_epi32(
+        _mm256_cvttpd_epi32(_mm256_mul_pd(_mm256_sub_pd(_mm256_maskload_pd(x, in), ov), ihv)),
+        offv); /* the held cells' (grid.off) */
     lov = _mm_min_epi32(lov, cv);
     hiv = _mm_max_epi32(hiv, cv);
     const int pl = _mm_cvtsi128_si32(
@@ -49,7 +50,7 @@ MPMC_ALWAYS_INLINE void count_chunk(const int DIM, const int ROWS, const mpmc_gr
 #else
     int c[3] = {0, 0, 0};
     for (int a = 0; a < DIM; ++a) {
-      c[a] = (int)((x[a] - o[a]) * ih);
+      c[a] = (int)((x[a] - o[a]) * ih) - g->off[a]; /* the held cells' (grid.off) */
       lo[a] = c[a] < lo[a] ? c[a] : lo[a];
       hi[a] = c[a] > hi[a] ? c[a] : hi[a];
     }

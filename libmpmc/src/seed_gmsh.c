@@ -589,7 +589,7 @@ static int buckets_build(mpmc_sim sim, int first, int count, buckets *bk) {
   size_t ncell = 1;
   bk->first = first, bk->count = count;
   for (int a = 0; a < 3; ++a) {
-    bk->nc[a] = a < d ? g->n[a] - 1 - 2 * MPMC_GHOST : 1;
+    bk->nc[a] = a < d ? g->ng[a] - 1 - 2 * MPMC_GHOST : 1;
     ncell *= (size_t)bk->nc[a];
   }
   bk->start = calloc(ncell + 1, sizeof(int));
@@ -725,7 +725,7 @@ static int group_nodes(mpmc_sim sim, const simplices *B, const char *name, int *
   long nn[3] = {1, 1, 1};
   size_t total = 1;
   for (int a = 0; a < d; ++a) {
-    nn[a] = g->n[a] - 2 * MPMC_GHOST; /* nodes 0 .. cells */
+    nn[a] = g->ng[a] - 2 * MPMC_GHOST; /* nodes 0 .. cells */
     total *= (size_t)nn[a];
   }
   unsigned char *in = calloc(total, 1);

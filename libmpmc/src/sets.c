@@ -157,7 +157,7 @@ int mpmc_sim_add_node_set(mpmc_sim sim, const char *name, int n, const int *ijk,
   const int d = sim->cfg.dim;
   for (int i = 0; i < n; ++i)
     for (int a = 0; a < d; ++a) {
-      const int cells = g->n[a] - 1 - 2 * MPMC_GHOST, v = ijk[(size_t)i * d + a];
+      const int cells = g->ng[a] - 1 - 2 * MPMC_GHOST, v = ijk[(size_t)i * d + a];
       MPMC_CHECK(v >= 0 && v <= cells, ctx, MPMC_ERR_ARG,
                  "node set '%s': node %d, index %d along axis %d outside [0, %d]", nm, i, v, a,
                  cells);

@@ -71,9 +71,10 @@ static int point_keys(mpmc_const_sim sim, double *key, double *half, int *clo, i
     clo[a] = a < d ? g->n[a] : 0;
     chi[a] = a < d ? -1 : 0;
   }
-  /* the cell coordinate (points stay inside the grid, the step checks; clamped for safety) */
-#define CELL_OF(q, a, s, c)                                                   \
-  const double s = (p->x[(size_t)(q) * d + (a)] - g->origin[a]) * g->inv_h; \
+  /* the held cell coordinate (points stay inside the grid, the step checks; clamped for
+   * safety); subtracting the held grid's offset is exact */
+#define CELL_OF(q, a, s, c)                                                                  \
+  const double s = (p->x[(size_t)(q) * d + (a)] - g->origin[a]) * g->inv_h - g->off[a];    \
   const int c = s >= 0.0 ? (s < g->n[a] - 1 ? (int)s : g->n[a] - 2) : 0
   for (int q = 0; q < n; ++q)
     for (int a = 0; a < d; ++a) {

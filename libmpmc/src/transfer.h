@@ -46,7 +46,8 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights4(const int DIM, const int BASIS, cons
   }
   /* the linear indices, in 32 bits (the grid has at most 2^31 nodes: mpmc_grid_setup) */
   typedef unsigned u4 __attribute__((vector_size(4 * sizeof(unsigned))));
-  const u4 nd = (u4)b[0] + (unsigned)g->n[0] * ((u4)b[1] + (unsigned)g->n[1] * (u4)b[2]);
+  const u4 nd = (u4)b[0] + (unsigned)g->n[0] * ((u4)b[1] + (unsigned)g->n[1] * (u4)b[2]) -
+                (unsigned)g->lin; /* the held nodes' (grid.off), modulo 2^32 */
   const mpmc_b4l ni = __builtin_convertvector(nd, mpmc_b4l);
   memcpy(t->node0, &ni, sizeof ni);
 }
@@ -71,7 +72,7 @@ MPMC_ALWAYS_INLINE void mpmc_point_weights1(const int DIM, const int BASIS, cons
     node0 += stride * (size_t)b;
     stride *= (size_t)g->n[a];
   }
-  t->node0[0] = (long long)node0;
+  t->node0[0] = (long long)node0 - g->lin;
 }
 
 /* Runs body with point q and its weights, lane l of t, for the points order[k] (order NULL:
@@ -293,7 +294,7 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights(const int DIM, const int BASIS, cons
     sp->st[a] = str * (size_t)k;
     str *= (size_t)g->n[a];
   }
-  sp->node0 = node0;
+  sp->node0 = node0 - (size_t)g->lin;
 }
 
 /* mpmc_stable_weights of the four points idx[0..3] at x, lanes the points: per axis one
@@ -322,6 +323,7 @@ MPMC_ALWAYS_INLINE void mpmc_stable_weights4(const int DIM, const int BASIS, con
     sp->st[a] = str * (size_t)mpmc_stable_step(BASIS);
     str *= (size_t)g->n[a];
   }
+  node0 -= g->lin;
   memcpy(sp->node0, &node0, sizeof node0);
 }
 
