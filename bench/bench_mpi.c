@@ -367,6 +367,31 @@ static void model(const result *one, const result *two, int steps) {
          "w >= %.0f cells, a cross-section of at most %.0f cells at 10^6 points per rank (w >= "
          "%.0f with a halo of 3 planes, the stencils' overlap)\n", barea, gnode, w10, cells / w10,
          w3);
+  /* plane strain: the same halo record and planes a node of the cut's line, 4 points a cell
+   * (2 x 2), the global grid a square; the halo alone (the compute rate measured is 3D's) */
+  const double cells2 = np / 4.0;
+  printf("2D (plane strain), 10^6 points per rank, 4 per cell (%.0f cells a rank), the global "
+         "grid a square of N^2 cells, N = (%.0f P)^(1/2); the halo bytes per node of a cut's "
+         "line as measured in 3D:\n%-6s %-7s %-15s %7s %8s %8s %9s\n", cells2, cells2, "ranks",
+         "decomp", "cells a rank", "min", "halo/own", "grid MB", "whole MB");
+  for (int i = 0; i < 3; ++i) {
+    const int P = ranks[i], q = (int)lround(sqrt((double)P)); /* blocks: q x q ranks */
+    const double N = sqrt(cells2 * P);
+    for (int d = 0; d < 2; ++d) {
+      const double ex = d ? N / q : N / P, ey = d ? N / q : N;
+      /* the faces of the cuts: a slab's two lines of N + 1 nodes; a block's four, staged
+       * (the second axis's lines grown by the first's halo planes) */
+      const double faces = d ? 2.0 * (ey + 1.0) + 2.0 * (ex + 1.0 + 2.0 * HALO_PLANES)
+                             : 2.0 * (ey + 1.0);
+      const double held = (ex + 2.0 * ghost + 1.0) * (d ? ey + 2.0 * ghost + 1.0 : N + 2.0 * ghost + 1.0);
+      char sub[32];
+      snprintf(sub, sizeof sub, "%.1fx%.1f", ex, ey);
+      printf("%-6d %-7s %-15s %7.1f %7.1f%% %8.1f %9.1f%s\n", P, d ? "block" : "slab", sub,
+             fmin(ex, ey), 100.0 * faces * barea / (cells2 * gnode), held * gnode / 1e6,
+             pow(N + 2.0 * ghost + 1.0, 2) * gnode / 1e6,
+             fmin(ex, ey) < min_cells ? "  thinner than 5 cells" : "");
+    }
+  }
 }
 
 /* ---- main ---------------------------------------------------------------------------- */
