@@ -11,6 +11,8 @@
  * verdict) goes through wf_all_*: in one process the library's arrays as they are; over
  * MPI every rank's points gathered on every rank and put in the order of their global ids,
  * so that each rank computes the same metrics, to the bit, whatever the number of ranks.
+ * What a reduction gives exactly in any order (a maximum, the value of the one rank that
+ * holds a point) reads each rank's own points instead (wf_own_*, wf_par_max, wf_par_one).
  * A gather costs O(all points) per call: it is done per series row and plot, not per step;
  * the points' order by global id is kept between steps (order_update). */
 #include <stdint.h>
@@ -72,6 +74,12 @@ double wf_par_max(double v) {
   double m = v;
   if (distributed()) MPI_Allreduce(&v, &m, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   return m;
+}
+
+double wf_par_one(double v, int mine) {
+  double one = mine ? v : -0.0; /* -0 + v = v, whatever the order of the additions */
+  if (distributed()) MPI_Allreduce(MPI_IN_PLACE, &one, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  return one;
 }
 
 long wf_par_total(long v) {
@@ -290,6 +298,20 @@ int wf_all_materials(mpmc_sim sim, const int **mat) {
   return view_ints(sim, local, e, 1, mat);
 }
 
+int wf_own_field(mpmc_sim sim, int field, double **data, int *n) {
+  *data = NULL;
+  int e = mpmc_sim_get_num_particles(sim, n);
+  if (!e) e = mpmc_sim_get_field(sim, field, data, NULL);
+  return distributed() ? local_part(sim, e) : e;
+}
+
+int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat) {
+  int e = 0;
+  if (ids) e = mpmc_sim_get_particle_ids(sim, ids);
+  if (mat && !e) e = mpmc_sim_get_material_ids(sim, mat);
+  return distributed() ? local_part(sim, e) : e;
+}
+
 void wf_all_release(void) {
   for (size_t k = 0; k < sizeof slots / sizeof *slots; ++k) {
     free(slots[k].buf);
@@ -319,6 +341,7 @@ int wf_par_agree(int err) { return err; }
 void wf_par_share(char *buf, int len) { (void)buf, (void)len; }
 long wf_par_total(long v) { return v; }
 double wf_par_max(double v) { return v; }
+double wf_par_one(double v, int mine) { return (void)mine, v; }
 int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) { return mpmc_sim_create(ctx, dim, sim); }
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta) {
   return mpmc_sim_checkpoint_read(ctx, path, sim, meta);
@@ -329,6 +352,15 @@ int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
 }
 int wf_all_ids(mpmc_sim sim, const int **ids) { return mpmc_sim_get_particle_ids(sim, ids); }
 int wf_all_materials(mpmc_sim sim, const int **mat) { return mpmc_sim_get_material_ids(sim, mat); }
+int wf_own_field(mpmc_sim sim, int field, double **data, int *n) {
+  const int e = mpmc_sim_get_num_particles(sim, n);
+  return e ? e : mpmc_sim_get_field(sim, field, data, NULL);
+}
+int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat) {
+  int e = ids ? mpmc_sim_get_particle_ids(sim, ids) : 0;
+  if (mat && !e) e = mpmc_sim_get_material_ids(sim, mat);
+  return e;
+}
 void wf_all_release(void) {}
 
 #endif

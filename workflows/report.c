@@ -103,45 +103,61 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
   return 0;
 }
 
+/* The maxima (run-out, surge front) and the tracked point from each rank's own points, then
+ * a reduction, exact in any order: no point is gathered for them over MPI.  The sums (centre
+ * of mass, hydrostatic error) go over every rank's points in the order of their global ids,
+ * the same bits whatever the number of ranks. */
+static int own_metrics(mpmc_sim sim, const wf_scene *sc, double *v) {
+  const wf_metrics *m = &sc->metrics;
+  const int d = sc->dim, tip = m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y];
+  double *x, *x0 = NULL;
+  const int *ids = NULL, *mat = NULL;
+  int n, e;
+  if ((e = wf_own_field(sim, MPMC_FIELD_POSITION, &x, &n))) return e;
+  if (tip && (e = wf_own_field(sim, MPMC_FIELD_X0, &x0, &n))) return e;
+  const int by_mat = m->enabled[WF_METRIC_RUNOUT] && m->runout_material >= 0;
+  if ((tip || by_mat) && (e = wf_own_ids(sim, tip ? &ids : NULL, by_mat ? &mat : NULL))) return e;
+  if (m->enabled[WF_METRIC_RUNOUT]) {
+    const int slide = by_mat ? sc->mats[m->runout_material].id : -1;
+    double front = -INFINITY;
+    for (int q = 0; q < n; ++q)
+      if (!mat || mat[q] == slide) front = fmax(front, x[(size_t)q * d + m->runout_axis]);
+    v[WF_METRIC_RUNOUT] = fmax(0.0, wf_par_max(front) - m->toe);
+  }
+  if (tip) {
+    int q = 0;
+    while (q < n && ids[q] != m->tip_id) ++q;
+    const int mine = q < n;
+    v[WF_METRIC_TIP_X] = wf_par_one(mine ? x[(size_t)q * d] - x0[(size_t)q * d] : 0.0, mine);
+    v[WF_METRIC_TIP_Y] =
+        wf_par_one(mine ? x[(size_t)q * d + 1] - x0[(size_t)q * d + 1] : 0.0, mine);
+  }
+  if (m->enabled[WF_METRIC_FRONT_X]) { /* the surge front: the farthest point along x */
+    double front = -INFINITY;
+    for (int q = 0; q < n; ++q) front = fmax(front, x[(size_t)q * d]);
+    v[WF_METRIC_FRONT_X] = wf_par_max(front);
+  }
+  return 0;
+}
+
 static int metrics_of_fields(mpmc_sim sim, const wf_scene *sc, double *v) {
   const wf_metrics *m = &sc->metrics;
-  double *x, *x0, *mass;
-  int np, e;
-  wf_all_count(sim, &np);
-  if ((e = wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL))) return e;
-  if ((e = wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL))) return e;
-  if ((e = wf_all_field(sim, MPMC_FIELD_MASS, &mass, NULL))) return e;
   const int d = sc->dim;
+  int e;
   for (int k = 0; k < WF_METRIC_COUNT; ++k) v[k] = NAN;
-  if (m->enabled[WF_METRIC_RUNOUT]) {
-    const int *mat = NULL;
-    if (m->runout_material >= 0 && (e = wf_all_materials(sim, &mat))) return e;
-    const int slide = m->runout_material >= 0 ? sc->mats[m->runout_material].id : -1;
-    double front = -INFINITY;
-    for (int q = 0; q < np; ++q)
-      if (!mat || mat[q] == slide) front = fmax(front, x[(size_t)q * d + m->runout_axis]);
-    v[WF_METRIC_RUNOUT] = fmax(0.0, front - m->toe);
-  }
-  if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {
-    const int *ids;
-    if ((e = wf_all_ids(sim, &ids))) return e;
-    size_t q = 0;
-    while ((int)q < np - 1 && ids[q] != m->tip_id) ++q;
-    v[WF_METRIC_TIP_X] = x[q * d] - x0[q * d];
-    v[WF_METRIC_TIP_Y] = x[q * d + 1] - x0[q * d + 1];
-  }
+  if ((e = own_metrics(sim, sc, v))) return e;
   if (m->enabled[WF_METRIC_COM_X]) {
+    double *x, *mass;
+    int np;
+    wf_all_count(sim, &np);
+    if ((e = wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL))) return e;
+    if ((e = wf_all_field(sim, MPMC_FIELD_MASS, &mass, NULL))) return e;
     double mx = 0, mt = 0;
     for (int q = 0; q < np; ++q) {
       mx += mass[q] * x[(size_t)q * d];
       mt += mass[q];
     }
     v[WF_METRIC_COM_X] = mt > 0 ? mx / mt : NAN;
-  }
-  if (m->enabled[WF_METRIC_FRONT_X]) { /* the surge front: the farthest point along x */
-    double front = -INFINITY;
-    for (int q = 0; q < np; ++q) front = fmax(front, x[(size_t)q * d]);
-    v[WF_METRIC_FRONT_X] = front;
   }
   if (m->enabled[WF_METRIC_HYDRO]) v[WF_METRIC_HYDRO] = m->hydro_frozen ? m->hydro_value : hydro_error(sim, sc);
   if (m->enabled[WF_METRIC_BEARING]) /* rigid.c: q/su averaged since the last series row */

@@ -396,6 +396,8 @@ int wf_par_agree(int err);
 void wf_par_share(char *buf, int len);
 long wf_par_total(long v);
 double wf_par_max(double v);
+/* v of the one rank whose mine is set, on every rank (collective; in one process v) */
+double wf_par_one(double v, int mine);
 /* A simulation over the run's ranks; one read back from a checkpoint over them. */
 int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim);
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);
@@ -413,6 +415,10 @@ int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp);
 int wf_all_ids(mpmc_sim sim, const int **ids);
 int wf_all_materials(mpmc_sim sim, const int **mat);
 void wf_all_release(void);
+/* This rank's own points (collective over MPI, a rank without points agreeing): their number
+ * and a field; their ids and material ids (either NULL: not asked). */
+int wf_own_field(mpmc_sim sim, int field, double **data, int *n);
+int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat);
 
 /* Monotonic wall-clock seconds (report.c). */
 double wf_now(void);
