@@ -25,6 +25,14 @@
 
 #include "wf.h"
 
+/* A rank without points may hold no array: its part is empty; the others' code decides (in
+ * one process e as it is: wf_par_agree). */
+static int local_part(mpmc_sim sim, int e) {
+  int n = 0;
+  mpmc_sim_get_num_particles(sim, &n);
+  return wf_par_agree(n == 0 ? 0 : e);
+}
+
 #ifdef MPMC_HAVE_MPI
 #include "mpmc_mpi.h"
 
@@ -248,13 +256,6 @@ int wf_all_count(mpmc_sim sim, int *n) {
   return e;
 }
 
-/* A rank without points may hold no array: its part is empty; the others' code decides. */
-static int local_part(mpmc_sim sim, int e) {
-  int n = 0;
-  mpmc_sim_get_num_particles(sim, &n);
-  return wf_par_agree(n == 0 ? 0 : e);
-}
-
 int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   int w = 0, total = 0;
   double *local = NULL;
@@ -298,20 +299,6 @@ int wf_all_materials(mpmc_sim sim, const int **mat) {
   return view_ints(sim, local, e, 1, mat);
 }
 
-int wf_own_field(mpmc_sim sim, int field, double **data, int *n) {
-  *data = NULL;
-  int e = mpmc_sim_get_num_particles(sim, n);
-  if (!e) e = mpmc_sim_get_field(sim, field, data, NULL);
-  return distributed() ? local_part(sim, e) : e;
-}
-
-int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat) {
-  int e = 0;
-  if (ids) e = mpmc_sim_get_particle_ids(sim, ids);
-  if (mat && !e) e = mpmc_sim_get_material_ids(sim, mat);
-  return distributed() ? local_part(sim, e) : e;
-}
-
 void wf_all_release(void) {
   for (size_t k = 0; k < sizeof slots / sizeof *slots; ++k) {
     free(slots[k].buf);
@@ -352,15 +339,22 @@ int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
 }
 int wf_all_ids(mpmc_sim sim, const int **ids) { return mpmc_sim_get_particle_ids(sim, ids); }
 int wf_all_materials(mpmc_sim sim, const int **mat) { return mpmc_sim_get_material_ids(sim, mat); }
-int wf_own_field(mpmc_sim sim, int field, double **data, int *n) {
-  const int e = mpmc_sim_get_num_particles(sim, n);
-  return e ? e : mpmc_sim_get_field(sim, field, data, NULL);
-}
-int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat) {
-  int e = ids ? mpmc_sim_get_particle_ids(sim, ids) : 0;
-  if (mat && !e) e = mpmc_sim_get_material_ids(sim, mat);
-  return e;
-}
 void wf_all_release(void) {}
 
 #endif
+
+/* ---- each rank's own points (one process: all of them) ---------------------------------- */
+
+int wf_own_field(mpmc_sim sim, int field, double **data, int *n) {
+  *data = NULL;
+  int e = mpmc_sim_get_num_particles(sim, n);
+  if (!e) e = mpmc_sim_get_field(sim, field, data, NULL);
+  return local_part(sim, e);
+}
+
+int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat) {
+  int e = 0;
+  if (ids) e = mpmc_sim_get_particle_ids(sim, ids);
+  if (mat && !e) e = mpmc_sim_get_material_ids(sim, mat);
+  return local_part(sim, e);
+}
