@@ -218,7 +218,7 @@ static int hold_slab(struct mpmc_sim_s *sim) {
       const size_t o = (size_t)c[0] + (size_t)old.n[0] * ((size_t)c[1] + (size_t)old.n[1] * (size_t)c[2]);
       memcpy(f + i * (size_t)w, sim->adr_f + o * (size_t)w, sizeof(double) * (size_t)w);
     } else
-      for (int c = 0; c < w; ++c) f[i * (size_t)w + c] = -2.0;
+      for (int k = 0; k < w; ++k) f[i * (size_t)w + k] = -2.0;
   }
   free(sim->adr_f);
   sim->adr_f = f;

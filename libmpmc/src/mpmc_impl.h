@@ -680,8 +680,8 @@ int mpmc_dd_balance_due(struct mpmc_sim_s *sim);
 /* v[0 .. n) summed over the ranks in rank order (the same bits on every rank) / maximum */
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n);
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n);
-/* v[0 .. n) summed over the ranks where at most one rank holds a nonzero value per entry
- * (x + 0 = x in any order: the same bits without mpmc_dd_sum's gather of every rank's v) */
+/* v[0 .. n) summed over the ranks where one rank holds an entry's value and the others -0
+ * (-0 + x = x in any order: the same bits without mpmc_dd_sum's gather of every rank's v) */
 void mpmc_dd_sum_disjoint(const struct mpmc_sim_s *sim, double *v, size_t n);
 /* 1 on the (lowest) rank whose v is the largest */
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v);
