@@ -108,6 +108,13 @@ foreach(np 2 3)
   # the self-weight column to rest: the tracked point's settlement
   mpmc_mpi_scene_test(column_2d ${np} column_2d.yaml "tip_displacement_y" 1e-9 1e-12 "")
 endforeach()
+# the dam break's centre of mass, surge front and hydrostatic error: exact sums and maxima
+# over each rank's own points (no point gathered), the same bits as in one process
+foreach(np 2 3)
+  mpmc_mpi_scene_test(dam_break ${np} dam_break.yaml
+    "center_of_mass_x;surge_front_x;hydrostatic_pressure_error" 0 0
+    "--set grid.cell_size=0.5 --set stages.collapse.end.time=0.3 --set snapshot_plots=[]")
+endforeach()
 # the 2D slope (J2 with softening, F-bar) at 0.5 m, 2 s of run-out (2.2 m), then continued to
 # 3 s on the other number of ranks; on 3 ranks from the geostatic state (K0 = 0.96), whose
 # columns' overburden takes in other ranks' points

@@ -7,14 +7,16 @@
  * the same library calls (all collective) and takes the same decisions; rank 0 alone writes
  * the files of the front end (series.csv, summary.json, plots) and the log.
  *
- * The front end's own reading of the points (metrics, plots, the factor of safety's
- * verdict) goes through wf_all_*: in one process the library's arrays as they are; over
- * MPI every rank's points gathered on every rank and put in the order of their global ids,
- * so that each rank computes the same metrics, to the bit, whatever the number of ranks.
- * What a reduction gives exactly in any order (a maximum, the value of the one rank that
- * holds a point) reads each rank's own points instead (wf_own_*, wf_par_max, wf_par_one).
- * A gather costs O(all points) per call: it is done per series row and plot, not per step;
- * the points' order by global id is kept between steps (order_update). */
+ * The series' metrics read each rank's own points (wf_own_*) and reduce what a reduction
+ * gives exactly in any order: a maximum, the value of the one rank that holds a point, and
+ * sums in exact arithmetic (wf_xsum, wf_par_xsum), so every rank has the same metrics, to
+ * the bit, whatever the number of ranks.  The rest of the front end's reading of the
+ * points (plots, the factor of safety's verdict, the metrics' set-up) goes through
+ * wf_all_*: in one process the library's arrays as they are; over MPI every rank's points
+ * gathered on every rank and put in the order of their global ids.  A gather costs O(all
+ * points) per call: it is done per plot and stage, not per step; the points' order by
+ * global id is kept between steps (order_update). */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,6 +33,77 @@ static int local_part(mpmc_sim sim, int e) {
   int n = 0;
   mpmc_sim_get_num_particles(sim, &n);
   return wf_par_agree(n == 0 ? 0 : e);
+}
+
+/* ---- exact sums ---------------------------------------------------------------------- */
+
+#define XSUM_LOW 1074 /* the bit of 2^0: the lowest bit is 2^-1074 */
+#define XSUM_MASK 0xffffffffu
+
+/* The digits to [0, 2^32), carrying upwards; the top digit keeps the sign.  The value is
+ * unchanged: each digit's excess is an exact multiple of 2^32 (the division is exact). */
+static void xsum_normalize(wf_xsum *s) {
+  for (int i = 0; i + 1 < WF_XSUM_DIGITS; ++i) {
+    const int64_t low = (int64_t)((uint64_t)s->d[i] & XSUM_MASK);
+    s->d[i + 1] += (s->d[i] - low) / ((int64_t)1 << 32);
+    s->d[i] = low;
+  }
+  s->adds = 0;
+}
+
+/* x = m 2^(p - 1074) with m < 2^53 an integer: m's bits into digits p / 32 .. p / 32 + 2.
+ * A digit takes at most two parts below 2^32 an addition, so 2^29 additions between two
+ * normalisations stay far below 2^63. */
+void wf_xsum_add(wf_xsum *s, double x) {
+  if (!isfinite(x)) {
+    s->special += x;
+    return;
+  }
+  if (x == 0.0) return;
+  if (++s->adds >= (1L << 29)) xsum_normalize(s);
+  int e;
+  uint64_t m = (uint64_t)ldexp(frexp(fabs(x), &e), 53); /* exact: 53 bits */
+  int p = e - 53 + XSUM_LOW;
+  if (p < 0) { /* a subnormal: its bits below 2^-1074 are zero */
+    m >>= -p;
+    p = 0;
+  }
+  const int k = p / 32, sh = p % 32;
+  const uint64_t lo = (m & XSUM_MASK) << sh, hi = (m >> 32) << sh; /* below 2^64, 2^53 */
+  const int64_t a0 = (int64_t)(lo & XSUM_MASK), a1 = (int64_t)((lo >> 32) + (hi & XSUM_MASK)),
+                a2 = (int64_t)(hi >> 32);
+  const int64_t sg = x < 0 ? -1 : 1;
+  s->d[k] += sg * a0;
+  s->d[k + 1] += sg * a1;
+  s->d[k + 2] += sg * a2;
+}
+
+static int xsum_bit(const wf_xsum *s, int i) { return (int)((uint64_t)s->d[i / 32] >> (i % 32) & 1u); }
+
+/* Normalised, the magnitude's bits read off from the highest one: 53 of them, rounded to
+ * nearest (ties to even) by the next bit and the rest; below 2^-1022 every bit is kept. */
+double wf_xsum_value(wf_xsum *s) {
+  if (s->special != 0.0 || isnan(s->special)) return s->special;
+  xsum_normalize(s);
+  wf_xsum a = *s;
+  const int neg = a.d[WF_XSUM_DIGITS - 1] < 0;
+  if (neg) {
+    for (int i = 0; i < WF_XSUM_DIGITS; ++i) a.d[i] = -a.d[i];
+    xsum_normalize(&a);
+  }
+  int top = 32 * WF_XSUM_DIGITS - 1;
+  while (top >= 0 && !xsum_bit(&a, top)) --top;
+  if (top < 0) return 0.0;
+  const int lo = top >= 52 ? top - 52 : 0;
+  uint64_t m = 0;
+  for (int i = top; i >= lo; --i) m = m << 1 | (uint64_t)xsum_bit(&a, i);
+  if (lo > 0 && xsum_bit(&a, lo - 1)) { /* at least half an ulp: up unless an exact tie at even */
+    int rest = 0;
+    for (int i = lo - 2; i >= 0 && !rest; --i) rest = xsum_bit(&a, i);
+    if (rest || (m & 1u)) ++m;
+  }
+  const double v = ldexp((double)m, lo - XSUM_LOW);
+  return neg ? -v : v;
 }
 
 #ifdef MPMC_HAVE_MPI
@@ -84,10 +157,30 @@ double wf_par_max(double v) {
   return m;
 }
 
-double wf_par_one(double v, int mine) {
-  double one = mine ? v : -0.0; /* -0 + v = v, whatever the order of the additions */
-  if (distributed()) MPI_Allreduce(MPI_IN_PLACE, &one, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
-  return one;
+void wf_par_one(double *v, int n, int mine) {
+  if (!distributed()) return;
+  for (int k = 0; k < n; ++k) /* -0 + v = v, whatever the order of the additions */
+    if (!mine) v[k] = -0.0;
+  MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+}
+
+/* The digits normalised (each below 2^32 but the top one) and added as integers: exact
+ * for any number of ranks below 2^31; the specials as doubles. */
+void wf_par_xsum(wf_xsum *s, int n) {
+  if (!distributed()) return;
+  int64_t d[WF_XSUM_MAX * WF_XSUM_DIGITS];
+  double sp[WF_XSUM_MAX];
+  for (int k = 0; k < n; ++k) {
+    xsum_normalize(&s[k]);
+    memcpy(d + (size_t)k * WF_XSUM_DIGITS, s[k].d, sizeof s[k].d);
+    sp[k] = s[k].special;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, d, n * WF_XSUM_DIGITS, MPI_INT64_T, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Allreduce(MPI_IN_PLACE, sp, n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  for (int k = 0; k < n; ++k) {
+    memcpy(s[k].d, d + (size_t)k * WF_XSUM_DIGITS, sizeof s[k].d);
+    s[k].special = sp[k];
+  }
 }
 
 long wf_par_total(long v) {
@@ -328,7 +421,8 @@ int wf_par_agree(int err) { return err; }
 void wf_par_share(char *buf, int len) { (void)buf, (void)len; }
 long wf_par_total(long v) { return v; }
 double wf_par_max(double v) { return v; }
-double wf_par_one(double v, int mine) { return (void)mine, v; }
+void wf_par_one(double *v, int n, int mine) { (void)v, (void)n, (void)mine; }
+void wf_par_xsum(wf_xsum *s, int n) { (void)s, (void)n; }
 int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) { return mpmc_sim_create(ctx, dim, sim); }
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta) {
   return mpmc_sim_checkpoint_read(ctx, path, sim, meta);

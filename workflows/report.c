@@ -37,23 +37,26 @@ static void give_back_x(mpmc_sim sim) {
 
 /* Hydrostatic pressure error (dam break, paper section 4.3): with p = -tr(sigma)/3 and the
  * reference p_ref = rho g (surface - x_v) (rho = mass / initial volume, x_v the coordinate
- * along gravity), sqrt(sum (p - p_ref)^2 / sum p_ref^2) over the material points. */
+ * along gravity), sqrt(sum (p - p_ref)^2 / sum p_ref^2) over the material points: each
+ * rank's own, in exact sums (the same bits on any number of ranks). */
 static double hydro_error(mpmc_sim sim, const wf_scene *sc) {
   const wf_metrics *m = &sc->metrics;
   double *x, *mass, *vol0, *sig;
   int np;
-  wf_all_count(sim, &np);
-  if (wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL) || wf_all_field(sim, MPMC_FIELD_MASS, &mass, NULL) ||
-      wf_all_field(sim, MPMC_FIELD_VOLUME0, &vol0, NULL) || wf_all_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
+  if (wf_own_field(sim, MPMC_FIELD_POSITION, &x, &np) || wf_own_field(sim, MPMC_FIELD_MASS, &mass, &np) ||
+      wf_own_field(sim, MPMC_FIELD_VOLUME0, &vol0, &np) || wf_own_field(sim, MPMC_FIELD_STRESS, &sig, &np))
     return NAN;
-  double num = 0, den = 0;
+  wf_xsum s[2]; /* num, den */
+  memset(s, 0, sizeof s);
   for (int q = 0; q < np; ++q) {
     const double depth = fmax(0.0, m->surface - x[(size_t)q * sc->dim + m->hydro_axis]);
     const double pref = mass[q] / vol0[q] * m->hydro_g * depth;
     const double p = -(sig[(size_t)q * 6] + sig[(size_t)q * 6 + 1] + sig[(size_t)q * 6 + 2]) / 3.0;
-    num += (p - pref) * (p - pref);
-    den += pref * pref;
+    wf_xsum_add(&s[0], (p - pref) * (p - pref));
+    wf_xsum_add(&s[1], pref * pref);
   }
+  wf_par_xsum(s, 2);
+  const double num = wf_xsum_value(&s[0]), den = wf_xsum_value(&s[1]);
   return den > 0 ? sqrt(num / den) : NAN;
 }
 
@@ -103,10 +106,9 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
   return 0;
 }
 
-/* The maxima (run-out, surge front) and the tracked point from each rank's own points, then
- * a reduction, exact in any order: no point is gathered for them over MPI.  The sums (centre
- * of mass, hydrostatic error) go over every rank's points in the order of their global ids,
- * the same bits whatever the number of ranks. */
+/* The metrics from each rank's own points, then a reduction exact in any order (a maximum,
+ * the value of the rank holding the tracked point, exact sums): no point is gathered for
+ * them over MPI, and they have the same bits on any number of ranks. */
 static int own_metrics(mpmc_sim sim, const wf_scene *sc, double *v) {
   const wf_metrics *m = &sc->metrics;
   const int d = sc->dim, tip = m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y];
@@ -128,9 +130,24 @@ static int own_metrics(mpmc_sim sim, const wf_scene *sc, double *v) {
     int q = 0;
     while (q < n && ids[q] != m->tip_id) ++q;
     const int mine = q < n;
-    v[WF_METRIC_TIP_X] = wf_par_one(mine ? x[(size_t)q * d] - x0[(size_t)q * d] : 0.0, mine);
-    v[WF_METRIC_TIP_Y] =
-        wf_par_one(mine ? x[(size_t)q * d + 1] - x0[(size_t)q * d + 1] : 0.0, mine);
+    double u[2] = {0.0, 0.0};
+    for (int a = 0; a < 2 && mine; ++a) u[a] = x[(size_t)q * d + a] - x0[(size_t)q * d + a];
+    wf_par_one(u, 2, mine);
+    v[WF_METRIC_TIP_X] = u[0];
+    v[WF_METRIC_TIP_Y] = u[1];
+  }
+  if (m->enabled[WF_METRIC_COM_X]) {
+    double *mass;
+    if ((e = wf_own_field(sim, MPMC_FIELD_MASS, &mass, &n))) return e;
+    wf_xsum s[2]; /* sum m x, sum m */
+    memset(s, 0, sizeof s);
+    for (int q = 0; q < n; ++q) {
+      wf_xsum_add(&s[0], mass[q] * x[(size_t)q * d]);
+      wf_xsum_add(&s[1], mass[q]);
+    }
+    wf_par_xsum(s, 2);
+    const double mx = wf_xsum_value(&s[0]), mt = wf_xsum_value(&s[1]);
+    v[WF_METRIC_COM_X] = mt > 0 ? mx / mt : NAN;
   }
   if (m->enabled[WF_METRIC_FRONT_X]) { /* the surge front: the farthest point along x */
     double front = -INFINITY;
@@ -142,23 +159,9 @@ static int own_metrics(mpmc_sim sim, const wf_scene *sc, double *v) {
 
 static int metrics_of_fields(mpmc_sim sim, const wf_scene *sc, double *v) {
   const wf_metrics *m = &sc->metrics;
-  const int d = sc->dim;
   int e;
   for (int k = 0; k < WF_METRIC_COUNT; ++k) v[k] = NAN;
   if ((e = own_metrics(sim, sc, v))) return e;
-  if (m->enabled[WF_METRIC_COM_X]) {
-    double *x, *mass;
-    int np;
-    wf_all_count(sim, &np);
-    if ((e = wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL))) return e;
-    if ((e = wf_all_field(sim, MPMC_FIELD_MASS, &mass, NULL))) return e;
-    double mx = 0, mt = 0;
-    for (int q = 0; q < np; ++q) {
-      mx += mass[q] * x[(size_t)q * d];
-      mt += mass[q];
-    }
-    v[WF_METRIC_COM_X] = mt > 0 ? mx / mt : NAN;
-  }
   if (m->enabled[WF_METRIC_HYDRO]) v[WF_METRIC_HYDRO] = m->hydro_frozen ? m->hydro_value : hydro_error(sim, sc);
   if (m->enabled[WF_METRIC_BEARING]) /* rigid.c: q/su averaged since the last series row */
     wf_bearing_values(sc, 1, &v[WF_METRIC_SETTLEMENT_B], &v[WF_METRIC_Q_SU], &v[WF_METRIC_BEARING]);

@@ -11,6 +11,7 @@
 #ifndef MPMC_WF_H
 #define MPMC_WF_H
 
+#include <stdint.h>
 #include <stdio.h>
 
 #include "mpmc.h"
@@ -396,8 +397,25 @@ int wf_par_agree(int err);
 void wf_par_share(char *buf, int len);
 long wf_par_total(long v);
 double wf_par_max(double v);
-/* v of the one rank whose mine is set, on every rank (collective; in one process v) */
-double wf_par_one(double v, int mine);
+/* v[0 .. n-1] of the one rank whose mine is set, on every rank, in place (collective; in
+ * one process v as it is) */
+void wf_par_one(double *v, int n, int mine);
+/* An exact sum of doubles: its value does not depend on the order of the additions, so
+ * each rank sums its own points and wf_par_xsum gives the same bits on any number of ranks
+ * as in one process.  A fixed-point number with its lowest bit at 2^-1074 (the least
+ * subnormal), 32 bits a digit; each digit takes 2^31 additions before wf_xsum_normalize. */
+#define WF_XSUM_DIGITS 68
+typedef struct { /* zeroed: 0 */
+  int64_t d[WF_XSUM_DIGITS];
+  double special; /* the infinities and NaNs added, summed as doubles (+-inf or NaN) */
+  long adds;      /* additions since the digits were last normalised */
+} wf_xsum;
+void wf_xsum_add(wf_xsum *s, double x);
+double wf_xsum_value(wf_xsum *s); /* the exact sum rounded to a double (one rounding) */
+/* s[0 .. n-1] summed over the ranks, in place, n <= WF_XSUM_MAX (collective; in one
+ * process nothing) */
+#define WF_XSUM_MAX 4
+void wf_par_xsum(wf_xsum *s, int n);
 /* A simulation over the run's ranks; one read back from a checkpoint over them. */
 int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim);
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);
