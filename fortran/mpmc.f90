@@ -161,8 +161,8 @@ module mpmc
     mpmc_context_set_log_level, mpmc_version
   public :: mpmc_sim_create, mpmc_sim_destroy, mpmc_sim_get_context, mpmc_sim_get_dim, &
     mpmc_sim_set_grid, mpmc_sim_get_grid, mpmc_sim_set_basis, mpmc_sim_set_fbar, &
-    mpmc_sim_get_fbar, mpmc_sim_set_flip_blend, mpmc_sim_set_gravity, mpmc_sim_set_damping, &
-    mpmc_sim_set_kinetic_damping, mpmc_sim_set_adaptive_damping, &
+    mpmc_sim_get_fbar, mpmc_sim_set_flip_blend, mpmc_sim_set_pic_diffusivity, mpmc_sim_set_gravity, &
+    mpmc_sim_set_damping, mpmc_sim_set_kinetic_damping, mpmc_sim_set_adaptive_damping, &
     mpmc_sim_get_adaptive_damping, mpmc_sim_set_solver, mpmc_sim_set_threads, &
     mpmc_sim_set_kernels, mpmc_sim_get_kernels, mpmc_sim_set_water_table, &
     mpmc_sim_set_water_table_plane, mpmc_sim_set_geostatic_stress
@@ -397,6 +397,13 @@ module mpmc
       import :: c_int, c_double, mpmc_sim
       type(mpmc_sim), value :: sim
       real(c_double), value :: eta
+      integer(c_int) :: ierr
+    end function
+    function mpmc_sim_set_pic_diffusivity(sim, d) bind(C, name='mpmc_sim_set_pic_diffusivity') &
+        result(ierr)
+      import :: c_int, c_double, mpmc_sim
+      type(mpmc_sim), value :: sim
+      real(c_double), value :: d
       integer(c_int) :: ierr
     end function
     function mpmc_sim_set_gravity(sim, g) bind(C, name='mpmc_sim_set_gravity') result(ierr)

@@ -46,6 +46,8 @@ static void test_bad_input(void **state) {
   EXPECT(mpmc_sim_set_fbar(sim, 5), MPMC_ERR_ARG, "fbar = 5");
   EXPECT(mpmc_sim_set_fbar(sim, -1), MPMC_ERR_ARG, "fbar = -1");
   EXPECT(mpmc_sim_set_flip_blend(sim, 1.5), MPMC_ERR_ARG, "FLIP/PIC blend = 1.5");
+  EXPECT(mpmc_sim_set_pic_diffusivity(sim, -1), MPMC_ERR_ARG, "PIC diffusivity D = -1");
+  EXPECT(mpmc_sim_set_pic_diffusivity(sim, INFINITY), MPMC_ERR_ARG, "PIC diffusivity D = inf");
   EXPECT(mpmc_sim_set_damping(sim, 1.0), MPMC_ERR_ARG, "local damping alpha = 1");
   EXPECT(mpmc_sim_set_solver(sim, 5), MPMC_ERR_ARG, "solver = 5");
   EXPECT(mpmc_sim_set_threads(sim, -2), MPMC_ERR_ARG, "threads = -2");

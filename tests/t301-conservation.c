@@ -1,9 +1,12 @@
 /* Conservation (issue 2, test 2): grid mass equals the points' mass; with no gravity and no
  * walls, total linear momentum is conserved to 1e-12 (relative to sum m|v|) over 1000 steps
- * for FLIP, PIC and a blend, every basis, with and without F-bar. */
+ * for FLIP, PIC and a blend, every basis, with and without F-bar.  A PIC diffusivity D
+ * (mpmc_sim_set_pic_diffusivity) steps exactly as the blend 1 - min(1, D dt / h^2) does. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
@@ -15,7 +18,10 @@ static double urand(unsigned *s) {
   return (*s >> 8) * (1.0 / 16777216.0) - 0.5;
 }
 
-static void run(int dim, int basis, double blend, int fbar, int nsteps) {
+/* D > 0: mpmc_sim_set_pic_diffusivity after the blend; *dt_out, *v_out (malloc'd): the
+ * step and the final velocities, when not NULL */
+static void run_pic(int dim, int basis, double blend, double D, int fbar, int nsteps, double *dt_out,
+                    double **v_out) {
   mpmc_context ctx;
   mpmc_sim sim;
   TCALL(mpmc_context_create(&ctx));
@@ -26,6 +32,7 @@ static void run(int dim, int basis, double blend, int fbar, int nsteps) {
   TCALL(mpmc_sim_set_basis(sim, basis));
   TCALL(mpmc_sim_set_fbar(sim, fbar));
   TCALL(mpmc_sim_set_flip_blend(sim, blend));
+  if (D > 0) TCALL(mpmc_sim_set_pic_diffusivity(sim, D));
   int mat;
   TCALL(mpmc_sim_add_material_neo_hookean(sim, 1000.0, 0.3, 1.0, &mat));
   double *x, *vol;
@@ -68,11 +75,42 @@ static void run(int dim, int basis, double blend, int fbar, int nsteps) {
                "(relative change %.3g > 1e-12)",
                dim, basis, blend, fbar, a, P, nsteps, P0[a], fabs(P - P0[a]) / scale);
   }
+  if (dt_out) *dt_out = dt;
+  if (v_out) {
+    *v_out = malloc(sizeof(double) * (size_t)n * (size_t)dim);
+    assert_non_null(*v_out);
+    memcpy(*v_out, v, sizeof(double) * (size_t)n * (size_t)dim);
+  }
   free(x);
   free(vol);
   mpmc_sim_destroy(&sim);
   mpmc_context_destroy(&ctx);
   test_ctx = NULL;
+}
+
+static void run(int dim, int basis, double blend, int fbar, int nsteps) {
+  run_pic(dim, basis, blend, 0.0, fbar, nsteps, NULL, NULL);
+}
+
+/* the diffusivity replaces the blend (set to 0.3 here, unused): the same bits as the blend
+ * 1 - min(1, D dt / h^2) of the same dt and h = 0.1, and pure PIC once D dt / h^2 >= 1 */
+static void test_pic_diffusivity(void **state) {
+  (void)state;
+  const int n = 10 * 10 * 4; /* 2D: 10 x 10 cells of 2 x 2 points */
+  const double ih = 1.0 / 0.1;
+  double dt, *va, *vb;
+  run_pic(2, MPMC_BASIS_UGIMP, 0.3, 0.3, 1, 200, &dt, &va);
+  const double eta = 1.0 - fmin(1.0, 0.3 * dt * ih * ih);
+  if (!(eta > 0.3 && eta < 1.0)) fail_msg("the case must blend: eta = %g", eta);
+  run_pic(2, MPMC_BASIS_UGIMP, eta, 0.0, 1, 200, NULL, &vb);
+  assert_memory_equal(va, vb, sizeof(double) * (size_t)n * 2);
+  free(va);
+  free(vb);
+  run_pic(2, MPMC_BASIS_BSPLINE2, 0.3, 2.0 / (dt * ih * ih), 0, 100, NULL, &va);
+  run_pic(2, MPMC_BASIS_BSPLINE2, 0.0, 0.0, 0, 100, NULL, &vb);
+  assert_memory_equal(va, vb, sizeof(double) * (size_t)n * 2);
+  free(va);
+  free(vb);
 }
 
 static void test_momentum_2d(void **state) {
@@ -93,6 +131,7 @@ int main(void) {
   const struct CMUnitTest tests[] = {
       cmocka_unit_test(test_momentum_2d),
       cmocka_unit_test(test_momentum_3d),
+      cmocka_unit_test(test_pic_diffusivity),
   };
   return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -31,6 +31,7 @@ static mpmc_sim build(int nthreads) {
   TCALL(mpmc_sim_set_grid(sim, lo, hi, 0.25));
   TCALL(mpmc_sim_set_fbar(sim, MPMC_FBAR_ANCHORED));
   TCALL(mpmc_sim_set_flip_blend(sim, 0.9));
+  TCALL(mpmc_sim_set_pic_diffusivity(sim, 2.5)); /* eta = 1 - 2.5 dt / h^2, not 0.9: kept by a restart */
   TCALL(mpmc_sim_set_gravity(sim, g));
   TCALL(mpmc_sim_set_damping(sim, 0.05));
   TCALL(mpmc_sim_set_threads(sim, nthreads));

@@ -189,6 +189,19 @@ static void test_bad_override(void **state) {
   const char *wok[] = {"water_table={points: [[0, 0.5], [2, 0.5]]}", "stages.0.end.time=0.0005"};
   e = run_lib(scene, DIR "/out-water", 2, wok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
   if (e != 0) fail_msg("--set water_table points: expected success, got %d: %s", e, msg);
+  /* a stage's PIC share: fixed (flip) or a diffusivity (pic_diffusivity), not both */
+  const char *pr[] = {"stages.0.flip=0.9", "stages.0.pic_diffusivity=50"};
+  e = run_lib(scene, DIR "/out-override", 2, pr, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set stages.0.flip and pic_diffusivity: expected a failure, got 0");
+  test_expect_in("--set pic_diffusivity", msg,
+                 "key 'stages.0.pic_diffusivity': a stage takes either flip (a fixed share a step) or pic_diffusivity, not both");
+  const char *prn[] = {"stages.0.pic_diffusivity=-5"};
+  e = run_lib(scene, DIR "/out-override", 1, prn, 0, msg, sizeof msg);
+  if (e == 0) fail_msg("--set stages.0.pic_diffusivity=-5: expected a failure, got 0");
+  test_expect_in("--set pic_diffusivity < 0", msg, "key 'stages.0.pic_diffusivity': must be");
+  const char *prok[] = {"stages.0.pic_diffusivity=50", "stages.0.end.time=0.0005"};
+  e = run_lib(scene, DIR "/out-pic-diffusivity", 2, prok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e != 0) fail_msg("--set stages.0.pic_diffusivity=50: expected success, got %d: %s", e, msg);
   const char *k0[] = {"stages.0.initial_stress={k0: -1}"};
   e = run_lib(scene, DIR "/out-override", 1, k0, 0, msg, sizeof msg);
   if (e == 0) fail_msg("--set stages.0.initial_stress k0 = -1: expected a failure, got 0");

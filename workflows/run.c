@@ -371,6 +371,7 @@ static int stage_setup(wf_run *w, int i) {
   WF_TRY(w, mpmc_sim_set_kinetic_damping(sim, s->kinetic_damping), "stages.%d.kinetic_damping", i);
   WF_TRY(w, mpmc_sim_set_adaptive_damping(sim, s->adaptive_damping), "stages.%d.adaptive_damping", i);
   WF_TRY(w, mpmc_sim_set_flip_blend(sim, s->flip), "stages.%d.flip", i);
+  WF_TRY(w, mpmc_sim_set_pic_diffusivity(sim, s->pic_diffusivity), "stages.%d.pic_diffusivity", i);
   WF_TRY(w, mpmc_sim_set_force_dt(sim, s->force_dt), "stages.%d.force_dt", i);
   int base = 0;
   for (int j = 0; j < i; ++j) base += sc->stages[j].nwalls;
@@ -986,6 +987,7 @@ int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride
         mpmc_sim_set_kinetic_damping(w.sim, s->kinetic_damping);
         mpmc_sim_set_adaptive_damping(w.sim, s->adaptive_damping);
         mpmc_sim_set_flip_blend(w.sim, s->flip);
+        mpmc_sim_set_pic_diffusivity(w.sim, s->pic_diffusivity);
       }
       err = run_all(&w, rec.stage, &rec.clock, rec.steps, rec.setup) ? last_code(ctx) : 0;
     }

@@ -636,7 +636,7 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
   sc->nstage = ss->n;
   sc->stages = calloc((size_t)ss->n, sizeof *sc->stages);
   if (!sc->stages) return fail_at(r, ss, "stages", "out of memory");
-  static const char *const keys[] = {"name", "gravity", "damping", "kinetic_damping", "adaptive_damping", "initial_stress", "flip", "walls", "remove_walls", "tractions",
+  static const char *const keys[] = {"name", "gravity", "damping", "kinetic_damping", "adaptive_damping", "initial_stress", "flip", "pic_diffusivity", "walls", "remove_walls", "tractions",
                                      "strength_reduction", "reset_velocity", "end", "dt_factor", "dt",
                                      "snapshots", "series_points", "rigid_bodies", "force_dt",
                                      "factor_of_safety", NULL};
@@ -676,6 +676,13 @@ static int read_stages(rd *r, const wf_node *root, wf_scene *sc) {
     /* absent: the scene's blend (a quasi-static stage of a FLIP scene takes a little PIC:
      * docs/theory.md) */
     if (get_num(r, n, p, "flip", 0, sc->flip, UNIT, &s->flip)) return -1;
+    /* or PIC as a diffusivity (mpmc_sim_set_pic_diffusivity): the share D dt / h^2 a step */
+    if (get_num(r, n, p, "pic_diffusivity", 0, 0.0, NONNEG, &s->pic_diffusivity)) return -1;
+    if (wf_map_get(n, "flip") && wf_map_get(n, "pic_diffusivity")) {
+      wf_key_join(full, sizeof full, p, "pic_diffusivity");
+      return fail_at(r, wf_map_get(n, "pic_diffusivity"), full,
+                     "a stage takes either flip (a fixed share a step) or pic_diffusivity, not both");
+    }
     const range srf = {0, INFINITY, 1, 0};
     /* 0: unchanged from the previous stage */
     if (get_num(r, n, p, "strength_reduction", 0, 0.0, srf, &s->strength_reduction)) return -1;

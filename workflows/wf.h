@@ -127,6 +127,7 @@ typedef struct {
   double adaptive_damping; /* damping ratio zeta of the estimated lowest mode, 0 off (mpmc_sim_set_adaptive_damping) */
   double k0;           /* initial_stress.k0: the geostatic state at the stage's start; 0: none */
   double flip; /* the stage's FLIP/PIC blend (the scene's where the stage sets none) */
+  double pic_diffusivity; /* > 0: PIC's share D dt / h^2 in place of flip [m^2/s] */
   int nwalls;
   wf_wall *walls;
   int nremove;

@@ -185,6 +185,12 @@ int mpmc_sim_set_basis(mpmc_sim sim, mpmc_basis basis);
 int mpmc_sim_set_fbar(mpmc_sim sim, mpmc_fbar_mode mode); /* scenes: ANCHORED */
 int mpmc_sim_get_fbar(mpmc_const_sim sim, mpmc_fbar_mode *mode);
 int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta);
+/* PIC's share as a diffusivity D [m^2/s], for quasi-static stages: with D > 0 each step of
+ * length dt on cells of size h blends eta = 1 - min(1, D dt / h^2) in place of the fixed
+ * blend above.  PIC damps a smooth motion of wavelength L by about D / L^2 a second
+ * whatever the time step (the bulk modulus) and the cell size, where a fixed share damps
+ * it by the share a step; 0 (the default) returns to the fixed blend. */
+int mpmc_sim_set_pic_diffusivity(mpmc_sim sim, double D);
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g);
 int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
 int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on); /* 0 off, 1 on */

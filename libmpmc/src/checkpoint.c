@@ -195,6 +195,7 @@ static int write_config(hid_t f, mpmc_const_sim sim) {
   herr_t st = 0;
   st |= mpmc_h5_attr_write(g, "dim_basis_fbar_solver_nthreads_forcedt", H5T_NATIVE_INT, 6, ints);
   st |= mpmc_h5_attr_write(g, "flip", H5T_NATIVE_DOUBLE, 1, &sim->cfg.flip);
+  st |= mpmc_h5_attr_write(g, "pic_diffusivity", H5T_NATIVE_DOUBLE, 1, &sim->cfg.pic_diff);
   st |= mpmc_h5_attr_write(g, "gravity", H5T_NATIVE_DOUBLE, 3, sim->cfg.gravity);
   st |= mpmc_h5_attr_write(g, "damping", H5T_NATIVE_DOUBLE, 1, &sim->cfg.damping);
   const double kd[2] = {sim->cfg.kdamp, sim->kd_ke}; /* kinetic damping: on, E_k of the last step */
@@ -368,6 +369,9 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
   int64_t sort[2] = {0, -1}; /* absent in files of before the sort: never sorted */
   if (H5Aexists(g, "sort_interval_last") > 0)
     st |= mpmc_h5_attr_read(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
+  double pic_diff = 0.0; /* absent in files of before the PIC diffusivity: off */
+  if (H5Aexists(g, "pic_diffusivity") > 0)
+    st |= mpmc_h5_attr_read(g, "pic_diffusivity", H5T_NATIVE_DOUBLE, 1, &pic_diff);
   double kd[2] = {0.0, -1.0}; /* absent in files of before kinetic damping: off */
   if (H5Aexists(g, "kinetic_damping") > 0)
     st |= mpmc_h5_attr_read(g, "kinetic_damping", H5T_NATIVE_DOUBLE, 2, kd);
@@ -387,6 +391,7 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
   MPMC_CALL(mpmc_sim_set_threads(sim, ints[4]));
   MPMC_CALL(mpmc_sim_set_force_dt(sim, ints[5]));
   MPMC_CALL(mpmc_sim_set_flip_blend(sim, flip));
+  MPMC_CALL(mpmc_sim_set_pic_diffusivity(sim, pic_diff));
   MPMC_CALL(mpmc_sim_set_gravity(sim, grav));
   MPMC_CALL(mpmc_sim_set_damping(sim, damp));
   MPMC_CALL(mpmc_sim_set_kinetic_damping(sim, kd[0] != 0.0));

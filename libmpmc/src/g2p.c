@@ -336,7 +336,9 @@ static int report(mpmc_sim sim, int q) {
 /** Phase 3 of the step. */
 int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   const mpmc_grid *g = &sim->grid;
-  g2p_ctx c = {.eta = sim->cfg.flip, .travel_scale = dt * g->inv_h,
+  const double D = sim->cfg.pic_diff; /* PIC as a diffusivity: the blend of this step's dt */
+  g2p_ctx c = {.eta = D > 0 ? 1.0 - fmin(1.0, D * dt * g->inv_h * g->inv_h) : sim->cfg.flip,
+               .travel_scale = dt * g->inv_h,
                .xold = sim->cfg.fbar == MPMC_FBAR_STABLE ? sim->fb.xn : NULL};
   for (int a = 0; a < sim->cfg.dim; ++a) {
     c.xmin[a] = g->lo[a] - g->h;

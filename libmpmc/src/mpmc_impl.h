@@ -445,6 +445,7 @@ typedef struct {
   int basis;
   int fbar;           /* F-bar's form (mpmc_fbar_mode; 0: off)                          */
   double flip;        /* FLIP/PIC blend eta (eq 13)                                    */
+  double pic_diff;    /* > 0: PIC's diffusivity D, eta = 1 - min(1, D dt / h^2)         */
   double gravity[3];
   double damping;     /* local damping alpha                                           */
   int kdamp;          /* kinetic damping on (damping.c, mpmc_kinetic_damping)           */

@@ -147,6 +147,15 @@ int mpmc_sim_set_flip_blend(mpmc_sim sim, double eta) {
   return MPMC_SUCCESS;
 }
 
+/** @brief PIC's diffusivity D [m^2/s] (> 0: eta = 1 - min(1, D dt / h^2) each step; 0: off). */
+int mpmc_sim_set_pic_diffusivity(mpmc_sim sim, double D) {
+  if (!sim) return MPMC_ERR_ARG;
+  MPMC_CHECK(isfinite(D) && D >= 0, sim->ctx, MPMC_ERR_ARG,
+             "PIC diffusivity D = %g [m^2/s] must be finite and >= 0 (0: the fixed FLIP/PIC blend)", D);
+  sim->cfg.pic_diff = D;
+  return MPMC_SUCCESS;
+}
+
 /** @brief Gravitational acceleration g[dim] [m/s^2]. */
 int mpmc_sim_set_gravity(mpmc_sim sim, const double *g) {
   if (!sim) return MPMC_ERR_ARG;
