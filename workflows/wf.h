@@ -404,7 +404,7 @@ void wf_par_one(double *v, int n, int mine);
 /* An exact sum of doubles: its value does not depend on the order of the additions, so
  * each rank sums its own points and wf_par_xsum gives the same bits on any number of ranks
  * as in one process.  A fixed-point number with its lowest bit at 2^-1074 (the least
- * subnormal), 32 bits a digit; each digit takes 2^31 additions before wf_xsum_normalize. */
+ * subnormal), 32 bits a digit, the digits' carries taken every 2^29 additions (adds). */
 #define WF_XSUM_DIGITS 68
 typedef struct { /* zeroed: 0 */
   int64_t d[WF_XSUM_DIGITS];
