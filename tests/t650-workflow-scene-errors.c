@@ -151,73 +151,70 @@ static void test_missing_mesh(void **state) {
             "key 'geometry.0.file'", "no/such.geo' not found");
 }
 
+/* --set overrides of the scene at path: these must fail, naming expected in the message
+ * (left in msg), and create no output directory; those must run. */
+static void set_fails(const char *path, int n, const char **sets, const char *what, const char *expected,
+                      char *msg, size_t len) {
+  const int e = run_lib(path, DIR "/out-override", n, sets, 0, msg, len);
+  if (e == 0) fail_msg("--set %s: expected a failure, got 0", what);
+  test_expect_in(what, msg, expected);
+  if (test_exists(DIR "/out-override")) fail_msg("--set %s: a failed --set created the output directory", what);
+}
+
+static void set_runs(const char *path, const char *out, int n, const char **sets, const char *what) {
+  char msg[2048];
+  const int e = run_lib(path, out, n, sets, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
+  if (e != 0) fail_msg("--set %s: expected success, got %d: %s", what, e, msg);
+}
+
 static void test_bad_override(void **state) {
   (void)state;
   char scene[] = DIR "/ok.yaml", msg[2048];
   write_scene(scene, "cell_size: 0.5", good_body);
   const char *sets[] = {"grid.cell_size=-2"};
-  int e = run_lib(scene, DIR "/out-override", 1, sets, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set grid.cell_size=-2: expected a failure, got 0");
-  test_expect_in("--set", msg, "key 'grid.cell_size': must be > 0 (got -2)");
+  set_fails(scene, 1, sets, "grid.cell_size=-2", "key 'grid.cell_size': must be > 0 (got -2)", msg, sizeof msg);
   test_expect_in("--set", msg, "--set grid.cell_size=-2");
   const char *typo[] = {"grid.cell_sise=1"};
-  e = run_lib(scene, DIR "/out-override", 1, typo, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set grid.cell_sise=1: expected a failure, got 0");
-  test_expect_in("--set typo", msg, "key 'grid.cell_sise': unknown key (did you mean 'cell_size'?)");
-  if (test_exists(DIR "/out-override")) fail_msg("a failed --set created the output directory");
+  set_fails(scene, 1, typo, "grid.cell_sise=1", "key 'grid.cell_sise': unknown key (did you mean 'cell_size'?)",
+            msg, sizeof msg);
   const char *fb[] = {"fbar=stabel"};
-  e = run_lib(scene, DIR "/out-override", 1, fb, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set fbar=stabel: expected a failure, got 0");
-  test_expect_in("--set fbar", msg, "key 'fbar': expected true, false, anchored, paper, total or stable (got 'stabel')");
+  set_fails(scene, 1, fb, "fbar=stabel",
+            "key 'fbar': expected true, false, anchored, paper, total or stable (got 'stabel')", msg, sizeof msg);
   const char *ok[] = {"fbar=stable", "stages.0.end.time=0.0005"};
-  e = run_lib(scene, DIR "/out-fbar-stable", 2, ok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
-  if (e != 0) fail_msg("--set fbar=stable: expected success, got %d: %s", e, msg);
+  set_runs(scene, DIR "/out-fbar-stable", 2, ok, "fbar=stable");
   const char *srt[] = {"sort_interval=-1"};
-  e = run_lib(scene, DIR "/out-override", 1, srt, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set sort_interval=-1: expected a failure, got 0");
-  test_expect_in("--set sort_interval", msg, "key 'sort_interval': must be in [0, 1e+09] (got -1)");
+  set_fails(scene, 1, srt, "sort_interval=-1", "key 'sort_interval': must be in [0, 1e+09] (got -1)", msg,
+            sizeof msg);
   /* water tables: x must increase; a plane is 3D only; a line runs */
   const char *wback[] = {"water_table={points: [[1, 1], [0, 0]]}"};
-  e = run_lib(scene, DIR "/out-override", 1, wback, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set water_table with x decreasing: expected a failure, got 0");
-  test_expect_in("--set water_table", msg,
-                 "key 'water_table.points.1': x = 0 must exceed the previous point's x = 1");
+  set_fails(scene, 1, wback, "water_table with x decreasing",
+            "key 'water_table.points.1': x = 0 must exceed the previous point's x = 1", msg, sizeof msg);
   const char *wplane[] = {"water_table={plane: [1, 0, 0]}"};
-  e = run_lib(scene, DIR "/out-override", 1, wplane, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set water_table plane in 2D: expected a failure, got 0");
-  test_expect_in("--set water_table plane", msg, "key 'water_table.plane': a plane is for 3D scenes");
+  set_fails(scene, 1, wplane, "water_table plane in 2D", "key 'water_table.plane': a plane is for 3D scenes", msg,
+            sizeof msg);
   const char *wok[] = {"water_table={points: [[0, 0.5], [2, 0.5]]}", "stages.0.end.time=0.0005"};
-  e = run_lib(scene, DIR "/out-water", 2, wok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
-  if (e != 0) fail_msg("--set water_table points: expected success, got %d: %s", e, msg);
+  set_runs(scene, DIR "/out-water", 2, wok, "water_table points");
   /* a stage's PIC share: fixed (flip) or a diffusivity (pic_diffusivity), not both */
   const char *pr[] = {"stages.0.flip=0.9", "stages.0.pic_diffusivity=50"};
-  e = run_lib(scene, DIR "/out-override", 2, pr, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set stages.0.flip and pic_diffusivity: expected a failure, got 0");
-  test_expect_in("--set pic_diffusivity", msg,
-                 "key 'stages.0.pic_diffusivity': a stage takes either flip (a fixed share a step) or pic_diffusivity, not both");
+  set_fails(scene, 2, pr, "stages.0.flip and pic_diffusivity",
+            "key 'stages.0.pic_diffusivity': a stage takes either flip (a fixed share a step) or pic_diffusivity, not both",
+            msg, sizeof msg);
   const char *prn[] = {"stages.0.pic_diffusivity=-5"};
-  e = run_lib(scene, DIR "/out-override", 1, prn, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set stages.0.pic_diffusivity=-5: expected a failure, got 0");
-  test_expect_in("--set pic_diffusivity < 0", msg, "key 'stages.0.pic_diffusivity': must be");
+  set_fails(scene, 1, prn, "stages.0.pic_diffusivity=-5", "key 'stages.0.pic_diffusivity': must be", msg,
+            sizeof msg);
   const char *prok[] = {"stages.0.pic_diffusivity=50", "stages.0.end.time=0.0005"};
-  e = run_lib(scene, DIR "/out-pic-diffusivity", 2, prok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
-  if (e != 0) fail_msg("--set stages.0.pic_diffusivity=50: expected success, got %d: %s", e, msg);
+  set_runs(scene, DIR "/out-pic-diffusivity", 2, prok, "stages.0.pic_diffusivity=50");
   const char *k0[] = {"stages.0.initial_stress={k0: -1}"};
-  e = run_lib(scene, DIR "/out-override", 1, k0, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set stages.0.initial_stress k0 = -1: expected a failure, got 0");
-  test_expect_in("--set initial_stress", msg, "key 'stages.0.initial_stress.k0': must be > 0 (got -1)");
+  set_fails(scene, 1, k0, "stages.0.initial_stress k0 = -1", "key 'stages.0.initial_stress.k0': must be > 0 (got -1)",
+            msg, sizeof msg);
   const char *k0ok[] = {"stages.0.initial_stress={k0: 0.5}", "stages.0.end.time=0.0005"};
-  e = run_lib(scene, DIR "/out-k0", 2, k0ok, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
-  if (e != 0) fail_msg("--set stages.0.initial_stress={k0: 0.5}: expected success, got %d: %s", e, msg);
+  set_runs(scene, DIR "/out-k0", 2, k0ok, "stages.0.initial_stress={k0: 0.5}");
   const char *ro[] = {"metrics={runout_distance: {material: nope}}"};
-  e = run_lib(scene, DIR "/out-override", 1, ro, 0, msg, sizeof msg);
-  if (e == 0) fail_msg("--set metrics.runout_distance.material=nope: expected a failure, got 0");
-  test_expect_in("--set runout material", msg,
-                 "key 'metrics.runout_distance.material': no material named 'nope' in materials");
+  set_fails(scene, 1, ro, "metrics.runout_distance.material=nope",
+            "key 'metrics.runout_distance.material': no material named 'nope' in materials", msg, sizeof msg);
   /* an empty list of snapshot plots is none, not an error; sorting every step runs */
   const char *none[] = {"snapshot_plots=[]", "sort_interval=1", "stages.0.end.time=0.0005"};
-  e = run_lib(scene, DIR "/out-noplots", 3, none, MPMC_WORKFLOW_FORCE, msg, sizeof msg);
-  if (e != 0) fail_msg("--set snapshot_plots=[] sort_interval=1: expected success, got %d: %s", e, msg);
+  set_runs(scene, DIR "/out-noplots", 3, none, "snapshot_plots=[] sort_interval=1");
 }
 
 static void test_existing_output(void **state) {
