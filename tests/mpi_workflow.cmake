@@ -53,6 +53,38 @@ if(CMAKE_SCRIPT_MODE_FILE)
       message(STATUS "${what}: ${key}: ${va} | ${vb}")
     endforeach()
   endfunction()
+  # The point-by-point CSVs rank 0 writes from the points it gathers (final_state.csv, the
+  # factor of safety's mechanism, the snapshot plots' data): present alike, the same header
+  # and rows, and each column's sum within RTOL (1e-6 at least) of the sum of its magnitudes
+  # (the rows' order differs: storage order in one process, global ids over MPI).
+  function(compare_csvs what a b)
+    file(GLOB names RELATIVE ${a} ${a}/final_state.csv ${a}/fos_mechanism.csv ${a}/snap_*.csv)
+    set(tol ${RTOL})
+    if(tol LESS 1e-6)
+      set(tol 1e-6)
+    endif()
+    foreach(f IN LISTS names)
+      if(NOT EXISTS ${b}/${f})
+        message(FATAL_ERROR "${what}: ${f} written in one process, not over MPI")
+      endif()
+      execute_process(COMMAND awk -F, -v tol=${tol} "
+          /^#/ { next }
+          !(FILENAME in head) { head[FILENAME] = \$0; next }
+          { rows[FILENAME]++; for (i = 1; i <= NF; ++i) { s[FILENAME, i] += \$i; m[FILENAME, i] += \$i < 0 ? -\$i : \$i }
+            nf = NF }
+          END { if (head[ARGV[1]] != head[ARGV[2]]) { print \"header: \" head[ARGV[1]] \" | \" head[ARGV[2]]; exit 1 }
+                if (rows[ARGV[1]] != rows[ARGV[2]]) { print \"rows: \" rows[ARGV[1]] \" | \" rows[ARGV[2]]; exit 1 }
+                for (i = 1; i <= nf; ++i) { d = s[ARGV[1], i] - s[ARGV[2], i]; if (d < 0) d = -d
+                  if (d > tol * m[ARGV[1], i] + 1e-12) { print \"column \" i \": \" s[ARGV[1], i] \" | \" s[ARGV[2], i]; exit 1 } }
+                print rows[ARGV[1]] \" rows\" }" ${a}/${f} ${b}/${f}
+        RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+      if(NOT rc EQUAL 0)
+        message(FATAL_ERROR "${what}: ${f} differs: ${out}")
+      endif()
+      string(STRIP "${out}" out)
+      message(STATUS "${what}: ${f}: ${out} alike")
+    endforeach()
+  endfunction()
 
   separate_arguments(sets UNIX_COMMAND "${SETS}")
   if(NOT CMD)
@@ -62,6 +94,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
   run_or_die("one process" ${MPMC} ${CMD} ${SCENE} --out ${OUT}/serial --force --quiet ${sets})
   run_or_die("${NP} ranks" ${mpirun} ${MPMC} ${CMD} ${SCENE} --out ${OUT}/np${NP} --force --quiet ${sets})
   compare("${NP} ranks" ${OUT}/serial ${OUT}/np${NP})
+  compare_csvs("${NP} ranks" ${OUT}/serial ${OUT}/np${NP})
   file(READ ${OUT}/np${NP}/summary.json s)
   string(JSON ranks GET "${s}" ranks)
   if(NOT ranks EQUAL NP)

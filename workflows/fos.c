@@ -32,30 +32,32 @@
 
 #define FOS_CHECK_EVERY 20 /* steps between displacement checks (a trial stops when it fails) */
 
-/* largest |x - xs[id]| over the points (xs by point id: the sort moves points); over MPI
- * the largest over the ranks (each its own points) */
-static double max_displacement(mpmc_sim sim, int dim, const double *xs) {
-  double *x;
-  const int *ids;
+/* largest |x - x0| over the points, x0 their positions at the trial's start (open_trial);
+ * over MPI the largest over the ranks (each its own points: nothing is gathered) */
+static double max_displacement(mpmc_sim sim, int dim) {
+  static const int fields[2] = {MPMC_FIELD_POSITION, MPMC_FIELD_X0};
+  double *f[2];
   int n = 0;
-  if (mpmc_sim_get_num_particles(sim, &n) || mpmc_sim_get_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
-      mpmc_sim_get_particle_ids(sim, &ids))
-    return NAN;
+  if (wf_own(sim, &n, 2, fields, f, NULL, NULL)) return NAN;
+  double *x = f[0];
+  const double *x0 = f[1];
   double m = 0.0;
   for (int q = 0; q < n; ++q) {
     double d2 = 0.0;
     for (int a = 0; a < dim; ++a) {
-      const double dx = x[(size_t)q * dim + a] - xs[(size_t)ids[q] * dim + a];
+      const double dx = x[(size_t)q * dim + a] - x0[(size_t)q * dim + a];
       d2 += dx * dx;
     }
     if (d2 > m) m = d2;
   }
+  mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, &x); /* on loan it costs each F-bar step a copy */
   return sqrt(wf_par_max(m));
 }
 
-/* the base state with the strengths divided by F, in *sim; its positions by id in *xs */
-static int open_trial(mpmc_context ctx, const char *base, const wf_scene *sc, double F, mpmc_sim *sim,
-                      double **xs) {
+/* The base state with the strengths divided by F, in *sim, each point's initial position
+ * (MPMC_FIELD_X0) set to its position in the base state: displacements count from the
+ * trial's start, and travel with the points across ranks. */
+static int open_trial(mpmc_context ctx, const char *base, const wf_scene *sc, double F, mpmc_sim *sim) {
   char *meta = NULL;
   int e = wf_par_checkpoint_read(ctx, base, sim, &meta);
   mpmc_free(meta);
@@ -63,18 +65,12 @@ static int open_trial(mpmc_context ctx, const char *base, const wf_scene *sc, do
   if (!e) e = mpmc_sim_set_threads(*sim, sc->threads);
   if (!e) e = mpmc_sim_set_sort_interval(*sim, sc->sort_interval);
   if (!e) e = mpmc_sim_set_strength_reduction(*sim, -1, F);
+  static const int fields[2] = {MPMC_FIELD_POSITION, MPMC_FIELD_X0};
+  double *f[2] = {NULL, NULL};
   int n = 0;
-  double *x;
-  const int *ids;
-  if (!e) e = wf_all_count(*sim, &n); /* over MPI: every rank's points */
-  if (!e) e = wf_all_field(*sim, MPMC_FIELD_POSITION, &x, NULL);
-  if (!e) e = wf_all_ids(*sim, &ids);
-  if (!e && xs) {
-    *xs = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1) * (size_t)sc->dim);
-    if (!*xs) e = MPMC_ERR_MEMORY;
-    for (int q = 0; !e && q < n; ++q)
-      for (int a = 0; a < sc->dim; ++a) (*xs)[(size_t)ids[q] * sc->dim + a] = x[(size_t)q * sc->dim + a];
-  }
+  if (!e) e = wf_own(*sim, &n, 2, fields, f, NULL, NULL);
+  if (!e && n > 0) memcpy(f[1], f[0], sizeof(double) * (size_t)n * (size_t)sc->dim);
+  if (f[0]) mpmc_sim_restore_field(*sim, MPMC_FIELD_POSITION, &f[0]);
   if (e) mpmc_sim_destroy(sim);
   return e;
 }
@@ -85,8 +81,7 @@ static int run_trial(mpmc_context ctx, const char *base, const wf_scene *sc, con
                      const char *mech, wf_fos_trial *t, char *msg, size_t len) {
   const double w0 = wf_now();
   mpmc_sim sim = NULL;
-  double *xs = NULL;
-  int e = open_trial(ctx, base, sc, F, &sim, &xs);
+  int e = open_trial(ctx, base, sc, F, &sim);
   if (e) {
     snprintf(msg, len, "trial F = %g: cannot start from %s: %s", F, base, mpmc_context_last_error(ctx));
     return e;
@@ -106,7 +101,7 @@ static int run_trial(mpmc_context ctx, const char *base, const wf_scene *sc, con
     if (steps % FOS_CHECK_EVERY == 0 || ts >= T * (1 - 1e-9)) {
       mpmc_sim_get_kinetic_energy(sim, &ke);
       if (ke > ke_max) ke_max = ke;
-      disp = max_displacement(sim, sc->dim, xs);
+      disp = max_displacement(sim, sc->dim);
       if (!(disp <= limit)) break; /* failed: no need to go on */
       if (d75 < 0 && ts >= 0.75 * T) d75 = disp;
     }
@@ -123,8 +118,7 @@ static int run_trial(mpmc_context ctx, const char *base, const wf_scene *sc, con
     t->steps = steps;
   }
   t->wall_seconds = wf_now() - w0;
-  if (!e && t->failed && mech) wf_fos_mechanism_write(sim, sc, xs, mech); /* no file: no mechanism plot */
-  free(xs);
+  if (!e && t->failed && mech) wf_fos_mechanism_write(sim, sc, mech); /* no file: no mechanism plot */
   mpmc_sim_destroy(&sim);
   return e;
 }

@@ -10,12 +10,13 @@
  * The series' metrics read each rank's own points (wf_own_*) and reduce what a reduction
  * gives exactly in any order: a maximum, the value of the one rank that holds a point, and
  * sums in exact arithmetic (wf_xsum, wf_par_xsum), so every rank has the same metrics, to
- * the bit, whatever the number of ranks.  The rest of the front end's reading of the
- * points (plots, the factor of safety's verdict, the metrics' set-up) goes through
- * wf_all_*: in one process the library's arrays as they are; over MPI every rank's points
- * gathered on every rank and put in the order of their global ids.  A gather costs O(all
- * points) per call: it is done per plot and stage, not per step; the points' order by
- * global id is kept between steps (order_update). */
+ * the bit, whatever the number of ranks; so do the metrics' set-up and the factor of
+ * safety's verdict.  Only what rank 0 writes point by point (the plots' CSVs, the factor of
+ * safety's mechanism) goes through wf_root_*: in one process the library's arrays as they
+ * are; over MPI every rank's points gathered on rank 0 alone and put in the order of their
+ * global ids.  A gather costs O(all points) on rank 0 per call: it is done per plot and
+ * stage, not per step; the points' order by global id is kept between steps
+ * (order_update). */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -157,6 +158,16 @@ double wf_par_max(double v) {
   return m;
 }
 
+int wf_par_least(double d, int id) {
+  if (!distributed()) return id;
+  struct {
+    double d;
+    int id;
+  } mine = {d, id}, least;
+  MPI_Allreduce(&mine, &least, 1, MPI_DOUBLE_INT, MPI_MINLOC, MPI_COMM_WORLD);
+  return least.id;
+}
+
 void wf_par_one(double *v, int n, int mine) {
   if (!distributed()) return;
   for (int k = 0; k < n; ++k) /* -0 + v = v, whatever the order of the additions */
@@ -241,8 +252,9 @@ static void *grow(slot *s, size_t bytes) {
 
 /* The order of the gathered points, kept while they stay where they are: every rank's
  * count and offset, and src[j], the gathered row of the point with the j-th smallest global
- * id.  Valid for one simulation between its steps (a step may migrate, sort or balance
- * points) while no rank's points change in number or order; a new simulation forgets it. */
+ * id (those two on rank 0, which alone receives the points).  Valid for one simulation
+ * between its steps (a step may migrate, sort or balance points) while no rank's points
+ * change in number or order; a new simulation forgets it. */
 static struct {
   mpmc_sim sim;
   int64_t steps;
@@ -273,40 +285,48 @@ static int order_update(mpmc_sim sim, int *width_io) {
   if (any[2]) return MPMC_ERR_STATE;
   if (!any[1]) return MPMC_SUCCESS;
   order_forget();
+  const int root = wf_par_rank() == 0;
   MPI_Comm_size(MPI_COMM_WORLD, &order.size);
   int *counts = realloc(order.counts, sizeof(int) * (size_t)order.size * 2);
   bad = !counts;
   if (counts) order.counts = counts;
   if (wf_par_agree(bad ? MPMC_ERR_MEMORY : 0)) return MPMC_ERR_MEMORY;
   int *displs = counts + order.size;
-  MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, MPI_COMM_WORLD);
+  MPI_Gather(&n, 1, MPI_INT, counts, 1, MPI_INT, 0, MPI_COMM_WORLD);
   long all = 0;
-  for (int r = 0; r < order.size; ++r) {
-    displs[r] = (int)all;
-    all += counts[r];
+  int *gid = NULL;
+  if (root) {
+    for (int r = 0; r < order.size; ++r) {
+      displs[r] = (int)all;
+      all += counts[r];
+    }
+    gid = malloc(sizeof(int) * (size_t)(all + 1));
+    long *src = realloc(order.src, sizeof(long) * (size_t)(all + 1));
+    if (src) order.src = src;
+    bad = !gid || !src;
   }
-  int *gid = malloc(sizeof(int) * (size_t)(all + 1));
-  long *src = realloc(order.src, sizeof(long) * (size_t)(all + 1));
-  if (src) order.src = src;
-  if (wf_par_agree(!gid || !src ? MPMC_ERR_MEMORY : 0)) {
+  if (wf_par_agree(bad ? MPMC_ERR_MEMORY : 0)) {
     free(gid);
     return MPMC_ERR_MEMORY;
   }
-  MPI_Allgatherv(ids, n, MPI_INT, gid, counts, displs, MPI_INT, MPI_COMM_WORLD);
-  int top = -1; /* ids are unique; order them by a table over [0, largest id] */
-  for (long k = 0; k < all; ++k) top = gid[k] > top ? gid[k] : top;
-  long *at = malloc(sizeof(long) * (size_t)(top + 2));
-  const int made = at != NULL;
-  if (made) {
-    for (long k = 0; k <= top; ++k) at[k] = -1;
-    for (long k = 0; k < all; ++k) at[gid[k]] = k;
-    long j = 0;
-    for (long k = 0; k <= top; ++k)
-      if (at[k] >= 0) src[j++] = at[k];
+  MPI_Gatherv(ids, n, MPI_INT, gid, counts, displs, MPI_INT, 0, MPI_COMM_WORLD);
+  long *at = NULL;
+  if (root) { /* ids are unique; order them by a table over [0, largest id] */
+    int top = -1;
+    for (long k = 0; k < all; ++k) top = gid[k] > top ? gid[k] : top;
+    at = malloc(sizeof(long) * (size_t)(top + 2));
+    bad = !at;
+    if (at) {
+      for (long k = 0; k <= top; ++k) at[k] = -1;
+      for (long k = 0; k < all; ++k) at[gid[k]] = k;
+      long j = 0;
+      for (long k = 0; k <= top; ++k)
+        if (at[k] >= 0) order.src[j++] = at[k];
+    }
   }
   free(gid);
   free(at);
-  if (wf_par_agree(made ? 0 : MPMC_ERR_MEMORY)) return MPMC_ERR_MEMORY;
+  if (wf_par_agree(bad ? MPMC_ERR_MEMORY : 0)) return MPMC_ERR_MEMORY;
   order.sim = sim;
   order.steps = st.steps;
   order.n = n;
@@ -316,25 +336,30 @@ static int order_update(mpmc_sim sim, int *width_io) {
 }
 
 /* Every rank's n local items of `width` values (MPI type t, `size` bytes each) gathered on
- * every rank in the order of the points' global ids, into slot s.  *total: the points. */
-static int gather(mpmc_sim sim, const void *local, int *width_io, MPI_Datatype t, size_t size, slot *s, int *total) {
+ * rank 0 in the order of the points' global ids, into slot s (collective; the other ranks
+ * send theirs and keep nothing). */
+static int gather(mpmc_sim sim, const void *local, int *width_io, MPI_Datatype t, size_t size, slot *s) {
   int err = order_update(sim, width_io);
   if (err) return err;
-  const int width = *width_io, nr = order.size;
+  const int width = *width_io, nr = order.size, root = wf_par_rank() == 0;
   const long all = order.all;
-  int *counts = malloc(sizeof(int) * (size_t)nr * 2);
-  char *vals = malloc(size * (size_t)width * (size_t)(all + 1));
-  char *out = grow(s, size * (size_t)width * (size_t)(all + 1));
-  if ((err = wf_par_agree(!counts || !vals || !out ? MPMC_ERR_MEMORY : 0))) {
+  int *counts = NULL;
+  char *vals = NULL, *out = NULL;
+  if (root) {
+    counts = malloc(sizeof(int) * (size_t)nr * 2);
+    vals = malloc(size * (size_t)width * (size_t)(all + 1));
+    out = grow(s, size * (size_t)width * (size_t)(all + 1));
+  }
+  if ((err = wf_par_agree(root && (!counts || !vals || !out) ? MPMC_ERR_MEMORY : 0))) {
     free(counts);
     free(vals);
     return err;
   }
-  for (int r = 0; r < 2 * nr; ++r) counts[r] = order.counts[r] * width;
-  MPI_Allgatherv(local, order.n * width, t, vals, counts, counts + nr, t, MPI_COMM_WORLD);
+  if (root)
+    for (int r = 0; r < 2 * nr; ++r) counts[r] = order.counts[r] * width;
+  MPI_Gatherv(local, order.n * width, t, vals, counts, root ? counts + nr : NULL, t, 0, MPI_COMM_WORLD);
   const size_t row = size * (size_t)width;
-  for (long j = 0; j < all; ++j) memcpy(out + row * (size_t)j, vals + row * (size_t)order.src[j], row);
-  *total = (int)all;
+  for (long j = 0; root && j < all; ++j) memcpy(out + row * (size_t)j, vals + row * (size_t)order.src[j], row);
   free(counts);
   free(vals);
   return MPMC_SUCCESS;
@@ -349,8 +374,8 @@ int wf_all_count(mpmc_sim sim, int *n) {
   return e;
 }
 
-int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
-  int w = 0, total = 0;
+int wf_root_field(mpmc_sim sim, int field, double **data, int *ncomp) {
+  int w = 0;
   double *local = NULL;
   int e = mpmc_sim_get_field(sim, field, &local, &w);
   if (ncomp) *ncomp = w;
@@ -360,39 +385,32 @@ int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   }
   /* a field this simulation does not have is missing on every rank alike */
   if ((e = local_part(sim, e))) return e;
-  e = gather(sim, local, &w, MPI_DOUBLE, sizeof(double), &slots[field], &total);
+  e = gather(sim, local, &w, MPI_DOUBLE, sizeof(double), &slots[field]);
   if (ncomp) *ncomp = w;
   if (field == MPMC_FIELD_POSITION) mpmc_sim_restore_field(sim, MPMC_FIELD_POSITION, &local);
-  *data = e ? NULL : slots[field].buf;
+  *data = e || wf_par_rank() != 0 ? NULL : slots[field].buf;
   return e;
 }
 
 static int view_ints(mpmc_sim sim, const int *local, int e, int which, const int **out) {
-  int total = 0;
   if (!distributed()) {
     *out = local;
     return e;
   }
   if ((e = local_part(sim, e))) return e;
   int one = 1;
-  e = gather(sim, local, &one, MPI_INT, sizeof(int), &slots[MPMC_FIELD_COUNT + which], &total);
-  *out = e ? NULL : slots[MPMC_FIELD_COUNT + which].buf;
+  e = gather(sim, local, &one, MPI_INT, sizeof(int), &slots[MPMC_FIELD_COUNT + which]);
+  *out = e || wf_par_rank() != 0 ? NULL : slots[MPMC_FIELD_COUNT + which].buf;
   return e;
 }
 
-int wf_all_ids(mpmc_sim sim, const int **ids) {
+int wf_root_ids(mpmc_sim sim, const int **ids) {
   const int *local = NULL;
   const int e = mpmc_sim_get_particle_ids(sim, &local);
   return view_ints(sim, local, e, 0, ids);
 }
 
-int wf_all_materials(mpmc_sim sim, const int **mat) {
-  const int *local = NULL;
-  const int e = mpmc_sim_get_material_ids(sim, &local);
-  return view_ints(sim, local, e, 1, mat);
-}
-
-void wf_all_release(void) {
+void wf_root_release(void) {
   for (size_t k = 0; k < sizeof slots / sizeof *slots; ++k) {
     free(slots[k].buf);
     slots[k].buf = NULL;
@@ -422,33 +440,30 @@ void wf_par_share(char *buf, int len) { (void)buf, (void)len; }
 long wf_par_total(long v) { return v; }
 double wf_par_max(double v) { return v; }
 void wf_par_one(double *v, int n, int mine) { (void)v, (void)n, (void)mine; }
+int wf_par_least(double d, int id) { return (void)d, id; }
 void wf_par_xsum(wf_xsum *s, int n) { (void)s, (void)n; }
 int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim) { return mpmc_sim_create(ctx, dim, sim); }
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta) {
   return mpmc_sim_checkpoint_read(ctx, path, sim, meta);
 }
 int wf_all_count(mpmc_sim sim, int *n) { return mpmc_sim_get_num_particles(sim, n); }
-int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp) {
+int wf_root_field(mpmc_sim sim, int field, double **data, int *ncomp) {
   return mpmc_sim_get_field(sim, field, data, ncomp);
 }
-int wf_all_ids(mpmc_sim sim, const int **ids) { return mpmc_sim_get_particle_ids(sim, ids); }
-int wf_all_materials(mpmc_sim sim, const int **mat) { return mpmc_sim_get_material_ids(sim, mat); }
-void wf_all_release(void) {}
+int wf_root_ids(mpmc_sim sim, const int **ids) { return mpmc_sim_get_particle_ids(sim, ids); }
+void wf_root_release(void) {}
 
 #endif
 
 /* ---- each rank's own points (one process: all of them) ---------------------------------- */
 
-int wf_own_field(mpmc_sim sim, int field, double **data, int *n) {
-  *data = NULL;
+int wf_own(mpmc_sim sim, int *n, int nf, const int *fields, double **data, const int **ids, const int **mat) {
   int e = mpmc_sim_get_num_particles(sim, n);
-  if (!e) e = mpmc_sim_get_field(sim, field, data, NULL);
-  return local_part(sim, e);
-}
-
-int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat) {
-  int e = 0;
-  if (ids) e = mpmc_sim_get_particle_ids(sim, ids);
+  for (int k = 0; k < nf; ++k) {
+    data[k] = NULL;
+    if (!e && fields[k] >= 0) e = mpmc_sim_get_field(sim, (mpmc_field)fields[k], &data[k], NULL);
+  }
+  if (ids && !e) e = mpmc_sim_get_particle_ids(sim, ids);
   if (mat && !e) e = mpmc_sim_get_material_ids(sim, mat);
   return local_part(sim, e);
 }

@@ -49,28 +49,26 @@ static const char *water_line(FILE *g, const wf_scene *sc, int hx) {
 }
 
 /* The points' state in final_state.csv's columns into path, far points first in 3D (looking
- * along the axis other than hx and vy); the displacement from the initial positions, or with
- * xs from xs (positions by point id).  *has_eps: an eps_p column with values.  0, or -1. */
-static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int hx, int vy, const double *xs,
-                       int *has_eps) {
+ * along the axis other than hx and vy); the displacement from the initial positions
+ * (MPMC_FIELD_X0).  *has_eps: an eps_p column with values.  0, or -1.  Over MPI the points
+ * are gathered on rank 0, which writes. */
+static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int hx, int vy, int *has_eps) {
   int np = 0;
-  double *x, *x0 = NULL, *sig, *eps = NULL;
-  const int *ids = NULL;
-  if (wf_all_count(sim, &np) || wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
-      (xs ? wf_all_ids(sim, &ids) : wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
-      wf_all_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
+  double *x, *x0, *sig, *eps = NULL;
+  if (wf_all_count(sim, &np) || wf_root_field(sim, MPMC_FIELD_POSITION, &x, NULL) ||
+      wf_root_field(sim, MPMC_FIELD_X0, &x0, NULL) || wf_root_field(sim, MPMC_FIELD_STRESS, &sig, NULL))
     return -1;
   int plastic = 0;
   for (int i = 0; i < sc->nmat; ++i) plastic |= wf_model_plastic(sc->mats[i].model);
-  if (plastic && wf_all_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
+  if (plastic && wf_root_field(sim, MPMC_FIELD_EPS_P, &eps, NULL)) eps = NULL;
   *has_eps = eps != NULL;
   /* the return region of the frictional models (docs/materials.md), last column */
   double *region = NULL;
-  if (wf_all_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
+  if (wf_root_field(sim, MPMC_FIELD_REGION, &region, NULL)) region = NULL;
   /* the water table's pore pressure, after it */
   double *pw = NULL;
-  if ((!sc->water.n && !sc->water.has_plane) || wf_all_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
-  if (wf_par_rank() != 0) return 0; /* over MPI: rank 0 writes (all ranks gathered) */
+  if ((!sc->water.n && !sc->water.has_plane) || wf_root_field(sim, MPMC_FIELD_PORE_PRESSURE, &pw, NULL)) pw = NULL;
+  if (wf_par_rank() != 0) return 0; /* over MPI: rank 0 writes (it gathered the points) */
   const int d = sc->dim;
   wf_depth_idx *order = malloc(sizeof *order * (size_t)(np + 1));
   FILE *f = fopen(path, "w");
@@ -90,7 +88,7 @@ static int write_state(mpmc_sim sim, const wf_scene *sc, const char *path, int h
   for (int k = 0; k < np; ++k) {
     const size_t q = (size_t)order[k].q;
     const double p = (sig[q * 6] + sig[q * 6 + 1] + sig[q * 6 + 2]) / 3.0;
-    const double *ref = xs ? xs + (size_t)ids[q] * d : x0 + q * d;
+    const double *ref = x0 + q * d;
     for (int a = 0; a < d; ++a) fprintf(f, "%.7g,", x[q * d + a]);
     fprintf(f, "%.7g,%.7g", p, eps ? eps[q] : 0.0);
     for (int a = 0; a < d; ++a) fprintf(f, ",%.7g", x[q * d + a] - ref[a]);
@@ -170,7 +168,7 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
   char path[WF_PATH + 32];
   int has_eps = 0;
   snprintf(path, sizeof path, "%s/final_state.csv", outdir);
-  if (write_state(sim, sc, path, hx, vy, NULL, &has_eps)) {
+  if (write_state(sim, sc, path, hx, vy, &has_eps)) {
     snprintf(warn, len, "cannot write %s", path);
     return 1;
   }
@@ -225,13 +223,14 @@ int wf_plots_write(mpmc_sim sim, const wf_scene *sc, const char *outdir, char *w
 
 /**
  * @brief The state at a trial's end in final_state.csv's columns, the displacement measured
- *        from xs (positions by point id at the trial's start), into path.  0, or -1.
+ *        from the trial's start (the trial sets the points' initial positions to those of
+ *        its base state: fos.c), into path.  0, or -1.
  */
-int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const double *xs, const char *path) {
+int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const char *path) {
   int hx, vy;
   wf_view_axes(sc, &hx, &vy);
   int has_eps;
-  return write_state(sim, sc, path, hx, vy, xs, &has_eps);
+  return write_state(sim, sc, path, hx, vy, &has_eps);
 }
 
 /**

@@ -41,11 +41,11 @@ static void give_back_x(mpmc_sim sim) {
  * rank's own, in exact sums (the same bits on any number of ranks). */
 static double hydro_error(mpmc_sim sim, const wf_scene *sc) {
   const wf_metrics *m = &sc->metrics;
-  double *x, *mass, *vol0, *sig;
+  static const int fields[4] = {MPMC_FIELD_POSITION, MPMC_FIELD_MASS, MPMC_FIELD_VOLUME0, MPMC_FIELD_STRESS};
+  double *f[4];
   int np;
-  if (wf_own_field(sim, MPMC_FIELD_POSITION, &x, &np) || wf_own_field(sim, MPMC_FIELD_MASS, &mass, &np) ||
-      wf_own_field(sim, MPMC_FIELD_VOLUME0, &vol0, &np) || wf_own_field(sim, MPMC_FIELD_STRESS, &sig, &np))
-    return NAN;
+  if (wf_own(sim, &np, 4, fields, f, NULL, NULL)) return NAN;
+  const double *x = f[0], *mass = f[1], *vol0 = f[2], *sig = f[3];
   wf_xsum s[2]; /* num, den */
   memset(s, 0, sizeof s);
   for (int q = 0; q < np; ++q) {
@@ -71,37 +71,38 @@ int wf_metrics_stage_end(mpmc_sim sim, wf_scene *sc, int stage) {
   return 0;
 }
 
-/** @brief Resolve the toe and the tracked point from the initial positions. */
+/** @brief Resolve the toe and the tracked point from the initial positions: each rank's own
+ *         points, then the largest toe and the nearest point over the ranks (collective). */
 int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
   const wf_metrics *m = &sc->metrics;
   double *x0;
+  const int *ids = NULL, *mat = NULL, field = MPMC_FIELD_X0;
   int np, e;
-  wf_all_count(sim, &np);
-  if ((e = wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL))) return e;
-  const int d = sc->dim;
-  const int *mat = NULL; /* the points of the run-out's material only, when it names one */
-  if (m->enabled[WF_METRIC_RUNOUT] && m->runout_material >= 0 && (e = wf_all_materials(sim, &mat)))
-    return e;
-  const int slide = m->runout_material >= 0 ? sc->mats[m->runout_material].id : -1;
-  if (m->enabled[WF_METRIC_RUNOUT] && !m->has_toe) {
-    double toe = -INFINITY;
+  const int d = sc->dim, toe = m->enabled[WF_METRIC_RUNOUT] && !m->has_toe;
+  const int tip = m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y];
+  /* the points of the run-out's material only, when it names one; the tracked point by id
+   * (the sort by cell, sort_interval, moves it to other indices) */
+  const int by_mat = toe && m->runout_material >= 0;
+  if ((e = wf_own(sim, &np, 1, &field, &x0, tip ? &ids : NULL, by_mat ? &mat : NULL))) return e;
+  if (toe) {
+    const int slide = by_mat ? sc->mats[m->runout_material].id : -1;
+    double t = -INFINITY;
     for (int q = 0; q < np; ++q)
-      if (!mat || mat[q] == slide) toe = fmax(toe, x0[(size_t)q * d + m->runout_axis]);
-    sc->metrics.toe = toe;
+      if (!mat || mat[q] == slide) t = fmax(t, x0[(size_t)q * d + m->runout_axis]);
+    sc->metrics.toe = wf_par_max(t);
   }
-  if (m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y]) {
-    /* by id: the sort by cell (sort_interval) moves the point to other indices */
-    const int *ids;
-    if ((e = wf_all_ids(sim, &ids))) return e;
+  if (tip) { /* the nearest point, the smallest id of the nearest alike */
     double best = INFINITY;
+    int id = -1;
     for (int q = 0; q < np; ++q) {
       double r2 = 0;
       for (int a = 0; a < d; ++a) r2 += pow(x0[(size_t)q * d + a] - m->point[a], 2);
-      if (r2 < best) {
+      if (r2 < best || (r2 == best && ids[q] < id)) {
         best = r2;
-        sc->metrics.tip_id = ids[q];
+        id = ids[q];
       }
     }
+    sc->metrics.tip_id = wf_par_least(best, id);
   }
   return 0;
 }
@@ -112,13 +113,14 @@ int wf_metrics_init(mpmc_sim sim, wf_scene *sc) {
 static int own_metrics(mpmc_sim sim, const wf_scene *sc, double *v) {
   const wf_metrics *m = &sc->metrics;
   const int d = sc->dim, tip = m->enabled[WF_METRIC_TIP_X] || m->enabled[WF_METRIC_TIP_Y];
-  double *x, *x0 = NULL;
   const int *ids = NULL, *mat = NULL;
-  int n, e;
-  if ((e = wf_own_field(sim, MPMC_FIELD_POSITION, &x, &n))) return e;
-  if (tip && (e = wf_own_field(sim, MPMC_FIELD_X0, &x0, &n))) return e;
   const int by_mat = m->enabled[WF_METRIC_RUNOUT] && m->runout_material >= 0;
-  if ((tip || by_mat) && (e = wf_own_ids(sim, tip ? &ids : NULL, by_mat ? &mat : NULL))) return e;
+  const int fields[3] = {MPMC_FIELD_POSITION, tip ? MPMC_FIELD_X0 : -1,
+                         m->enabled[WF_METRIC_COM_X] ? MPMC_FIELD_MASS : -1};
+  double *f[3];
+  int n, e;
+  if ((e = wf_own(sim, &n, 3, fields, f, tip ? &ids : NULL, by_mat ? &mat : NULL))) return e;
+  const double *x = f[0], *x0 = f[1], *mass = f[2];
   if (m->enabled[WF_METRIC_RUNOUT]) {
     const int slide = by_mat ? sc->mats[m->runout_material].id : -1;
     double front = -INFINITY;
@@ -137,8 +139,6 @@ static int own_metrics(mpmc_sim sim, const wf_scene *sc, double *v) {
     v[WF_METRIC_TIP_Y] = u[1];
   }
   if (m->enabled[WF_METRIC_COM_X]) {
-    double *mass;
-    if ((e = wf_own_field(sim, MPMC_FIELD_MASS, &mass, &n))) return e;
     wf_xsum s[2]; /* sum m x, sum m */
     memset(s, 0, sizeof s);
     for (int q = 0; q < n; ++q) {

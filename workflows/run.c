@@ -758,7 +758,7 @@ static int finish(wf_run *w, int err) {
 #endif
   mpmc_output_destroy(&w->snap);
   mpmc_sim_destroy(&w->sim);
-  wf_all_release();
+  wf_root_release();
   free(w->rec);
   free(w->fos);
   free(w->wall_ids);

@@ -41,13 +41,13 @@ static int write_csv_fields(mpmc_sim sim, const wf_scene *sc, const wf_snapplot 
   int np, e;
   double *x, *x0, *v, *sig, *eps = NULL;
   wf_all_count(sim, &np);
-  if ((e = wf_all_field(sim, MPMC_FIELD_POSITION, &x, NULL)) ||
-      (e = wf_all_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
-      (e = wf_all_field(sim, MPMC_FIELD_VELOCITY, &v, NULL)) ||
-      (e = wf_all_field(sim, MPMC_FIELD_STRESS, &sig, NULL)))
+  if ((e = wf_root_field(sim, MPMC_FIELD_POSITION, &x, NULL)) ||
+      (e = wf_root_field(sim, MPMC_FIELD_X0, &x0, NULL)) ||
+      (e = wf_root_field(sim, MPMC_FIELD_VELOCITY, &v, NULL)) ||
+      (e = wf_root_field(sim, MPMC_FIELD_STRESS, &sig, NULL)))
     return e;
-  if (p->color == WF_COLOR_EPS_P && (e = wf_all_field(sim, MPMC_FIELD_EPS_P, &eps, NULL))) return e;
-  if (wf_par_rank() != 0) return 0; /* over MPI: rank 0 writes (all ranks gathered) */
+  if (p->color == WF_COLOR_EPS_P && (e = wf_root_field(sim, MPMC_FIELD_EPS_P, &eps, NULL))) return e;
+  if (wf_par_rank() != 0) return 0; /* over MPI: rank 0 writes (it gathered the points) */
   const int d = sc->dim;
   int hx, vy;
   wf_view_axes(sc, &hx, &vy);

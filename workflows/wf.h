@@ -315,8 +315,8 @@ typedef struct {
 } wf_depth_idx;
 int wf_by_depth(const void *a, const void *b);
 /* The state at a trial's end as a CSV in final_state.csv's columns, the displacement since
- * the trial's start (xs: positions by point id) (plot.c); 0, or -1. */
-int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const double *xs, const char *path);
+ * the trial's start (the points' initial positions, which the trial sets) (plot.c); 0, or -1. */
+int wf_fos_mechanism_write(mpmc_sim sim, const wf_scene *sc, const char *path);
 /* fos_mechanism.png (from fos_mechanism.csv, when res->mechanism) and fos_trials.png (from
  * fos_trials.csv) in outdir; 0, or 1 with a warning (gnuplot missing or failed). */
 int wf_fos_plots(const wf_scene *sc, int stage, const wf_fos_result *res, const char *outdir, char *warn,
@@ -401,6 +401,9 @@ double wf_par_max(double v);
 /* v[0 .. n-1] of the one rank whose mine is set, on every rank, in place (collective; in
  * one process v as it is) */
 void wf_par_one(double *v, int n, int mine);
+/* The id of the least (d, id) over the ranks, d first, the smaller id on a tie; each rank
+ * gives its own least (d = INFINITY when it has none) (collective; in one process id). */
+int wf_par_least(double d, int id);
 /* An exact sum of doubles: its value does not depend on the order of the additions, so
  * each rank sums its own points and wf_par_xsum gives the same bits on any number of ranks
  * as in one process.  A fixed-point number with its lowest bit at 2^-1074 (the least
@@ -426,18 +429,19 @@ void wf_par_plan(mpmc_sim sim, char *line, size_t len);
  * After a run, *imbalance: the most points on a rank over the mean, *balances: done. */
 int wf_par_balance(mpmc_sim sim, int every, double threshold);
 void wf_par_imbalance(mpmc_sim sim, double *imbalance, long *balances);
-/* Every point, read only (collective): like mpmc_sim_get_num_particles / _get_field /
- * _get_particle_ids / _get_material_ids, but over MPI every rank's points, gathered in the
- * order of their global ids (valid until the next call for the same field). */
+/* The points over the ranks (collective; in one process this one's). */
 int wf_all_count(mpmc_sim sim, int *n);
-int wf_all_field(mpmc_sim sim, int field, double **data, int *ncomp);
-int wf_all_ids(mpmc_sim sim, const int **ids);
-int wf_all_materials(mpmc_sim sim, const int **mat);
-void wf_all_release(void);
-/* This rank's own points (collective over MPI, a rank without points agreeing): their number
- * and a field; their ids and material ids (either NULL: not asked). */
-int wf_own_field(mpmc_sim sim, int field, double **data, int *n);
-int wf_own_ids(mpmc_sim sim, const int **ids, const int **mat);
+/* Every point, read only, on rank 0 (collective): like mpmc_sim_get_field /
+ * _get_particle_ids, but over MPI every rank's points gathered on rank 0 in the order of
+ * their global ids (valid until the next call for the same field); the other ranks get
+ * NULL and hold nothing.  For what rank 0 alone writes point by point. */
+int wf_root_field(mpmc_sim sim, int field, double **data, int *ncomp);
+int wf_root_ids(mpmc_sim sim, const int **ids);
+void wf_root_release(void);
+/* This rank's own points (collective over MPI, a rank without points agreeing, once for
+ * all asked): their number, the fields asked (data[k] of fields[k]; NULL where fields[k] < 0),
+ * their ids and material ids (either NULL: not asked). */
+int wf_own(mpmc_sim sim, int *n, int nf, const int *fields, double **data, const int **ids, const int **mat);
 
 /* Monotonic wall-clock seconds (report.c). */
 double wf_now(void);
