@@ -1002,48 +1002,77 @@ int mpmc_dd_balance_due(struct mpmc_sim_s *sim) {
 
 /* ---- every rank's records ------------------------------------------------------------ */
 
-int mpmc_dd_allgather(struct mpmc_sim_s *sim, const void *mine, int n, size_t size, void **all,
-                      int *total, int *offset) {
-  *all = NULL;
-  *total = n;
-  *offset = 0;
+int mpmc_dd_exchange(struct mpmc_sim_s *sim, const void *send, const int *scount, size_t size, void **recv,
+                     int *rcount, int *rtotal) {
+  *recv = NULL;
+  *rtotal = 0;
 #ifdef MPMC_HAVE_MPI
   struct mpmc_dd_s *dd = sim->dd;
   if (dd) {
-    int *count = malloc(sizeof *count * 2 * (size_t)dd->size), err = MPMC_SUCCESS;
-    if (!count)
-      err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the counts of %d ranks", dd->size);
+    const int P = dd->size;
+    int *sd = malloc(sizeof *sd * 2 * (size_t)P), err = MPMC_SUCCESS;
+    if (!sd) err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate the counts of %d ranks", P);
     MPMC_CALL(mpmc_dd_agree(sim, err)); /* every rank has its counts, or none goes on */
-    MPI_Allgather(&n, 1, MPI_INT, count, 1, MPI_INT, dd->comm);
-    long long sum = 0;
-    for (int r = 0; r < dd->size; ++r) {
-      count[dd->size + r] = (int)sum; /* displacement, in records */
-      if (r == dd->rank) *offset = (int)sum;
-      sum += count[r];
+    int *rd = sd + P;
+    MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, dd->comm);
+    long long s = 0, r = 0;
+    for (int k = 0; k < P; ++k) {
+      sd[k] = (int)s;
+      rd[k] = (int)r;
+      s += scount[k];
+      r += rcount[k];
     }
-    if (sum > INT_MAX)
-      err = MPMC_ERROR(sim->ctx, MPMC_ERR_ARG, "%lld points over the ranks: more than %d", sum, INT_MAX);
-    else if (!(*all = malloc(size * (size_t)(sum > 0 ? sum : 1))))
-      err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %lld records of %zu bytes", sum, size);
-    err = mpmc_dd_agree(sim, err);
-    if (err) {
-      free(count);
-      free(*all);
-      *all = NULL;
+    if (r > INT_MAX)
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_ARG, "%lld records for one rank: more than %d", r, INT_MAX);
+    else if (!(*recv = malloc(size * (size_t)(r > 0 ? r : 1))))
+      err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate %lld records of %zu bytes", r, size);
+    if ((err = mpmc_dd_agree(sim, err))) {
+      free(sd);
+      free(*recv);
+      *recv = NULL;
       return err;
     }
     MPI_Datatype rec;
     MPI_Type_contiguous((int)size, MPI_BYTE, &rec);
     MPI_Type_commit(&rec);
-    MPI_Allgatherv(mine, n, rec, *all, count, count + dd->size, rec, dd->comm);
+    MPI_Alltoallv(send, scount, sd, rec, *recv, rcount, rd, rec, dd->comm);
     MPI_Type_free(&rec);
-    *total = (int)sum;
-    free(count);
+    *rtotal = (int)r;
+    free(sd);
     return MPMC_SUCCESS;
   }
 #endif
-  MPMC_CHECK(*all = malloc(size * (size_t)(n > 0 ? n : 1)), sim->ctx, MPMC_ERR_MEMORY,
+  const int n = scount[0];
+  MPMC_CHECK(*recv = malloc(size * (size_t)(n > 0 ? n : 1)), sim->ctx, MPMC_ERR_MEMORY,
              "cannot allocate %d records of %zu bytes", n, size);
-  if (n > 0) memcpy(*all, mine, size * (size_t)n);
+  if (n > 0) memcpy(*recv, send, size * (size_t)n);
+  rcount[0] = *rtotal = n;
   return MPMC_SUCCESS;
+}
+
+/* Of the non-negative doubles the bit patterns are ordered as the values: the least pattern
+ * t with more than k values at or below it, by bisection, is the k-th smallest value. */
+double mpmc_dd_kth(const struct mpmc_sim_s *sim, const double *v, int n, long long k) {
+  uint64_t lo = 0, hi = UINT64_C(0x7ff0000000000000); /* +0 .. +inf */
+  while (lo < hi) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    long long c = 0;
+    for (int q = 0; q < n; ++q) {
+      uint64_t b;
+      memcpy(&b, v + q, sizeof b);
+      c += b <= mid;
+    }
+#ifdef MPMC_HAVE_MPI
+    if (sim->dd) MPI_Allreduce(MPI_IN_PLACE, &c, 1, MPI_LONG_LONG, MPI_SUM, sim->dd->comm);
+#else
+    (void)sim;
+#endif
+    if (c > k)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  double t;
+  memcpy(&t, &lo, sizeof t);
+  return t;
 }

@@ -689,10 +689,15 @@ int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v);
 /* the least v over the ranks and, of the ranks that have it, the least id (collective);
  * without any: v = +inf and id = -1 */
 void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id);
-/* every rank's n records of size bytes, in rank order, into *all (malloc'ed; the caller
- * frees it): *total records, this rank's from *offset (collective; one process: a copy) */
-int mpmc_dd_allgather(struct mpmc_sim_s *sim, const void *mine, int n, size_t size, void **all,
-                      int *total, int *offset);
+/* Records to other ranks: send holds scount[r] records of size bytes for each rank r, rank
+ * after rank; *recv (malloc'ed, the caller frees it) gets rcount[r] from each rank r, rank
+ * after rank, *rtotal in all (collective; one process: a copy).  scount, rcount: [ranks]. */
+int mpmc_dd_exchange(struct mpmc_sim_s *sim, const void *send, const int *scount, size_t size, void **recv,
+                     int *rcount, int *rtotal);
+/* The k-th smallest (from 0) of every rank's v[0 .. n), non-negative and not NaN, exactly,
+ * without gathering them: a bisection over the values with one count over the ranks a bit
+ * (collective; in one process the same bisection) */
+double mpmc_dd_kth(const struct mpmc_sim_s *sim, const double *v, int n, long long k);
 /* the number of ranks (1 in one process) */
 int mpmc_dd_ranks(const struct mpmc_sim_s *sim);
 /* the decomposition's communicator (an MPI_Comm; NULL in one process) */
