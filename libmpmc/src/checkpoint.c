@@ -154,26 +154,52 @@ static int select_rows(hid_t g, mpmc_sim sim, ckpt_rows *k) {
 
 /* ---- block: configuration, grid, time, statistics ----------------------------------------- */
 
-/* Adaptive damping's node store as one array over the whole grid: in one process the rank's
- * own; over MPI each node from the rank whose slab holds its plane (damping.c: a node with
- * mass last step holds the same values on every rank that has it), the others' -0, summed
- * over the ranks.  A restart on any number of ranks then finds every node's last force.
- * NULL: no memory. */
-static double *adaptive_nodes(mpmc_const_sim sim) {
-  if (!sim->dd || sim->adr_own[0] < 0) return sim->adr_f;
-  const int ax = sim->adr_own[0], w = 1 + sim->cfg.dim;
-  const size_t all = mpmc_grid_global_nodes(&sim->grid) * (size_t)w;
-  double *a = malloc(all * sizeof *a);
-  if (!a) return NULL;
-  for (size_t k = 0; k < all; ++k) a[k] = -0.0; /* -0 + x = x for every x, -0 and +0 too */
-  for (size_t i = 0; i < sim->grid.nn; ++i) {
-    const long k = mpmc_grid_plane(&sim->grid, ax, i);
-    if (k < sim->adr_own[1] || k >= sim->adr_own[2]) continue;
-    memcpy(a + mpmc_grid_global(&sim->grid, i) * (size_t)w, sim->adr_f + i * (size_t)w,
-           sizeof(double) * (size_t)w);
+/* The whole grid's nodes whose planes along axis a are [lo, hi) (global planes), the other
+ * axes whole, as rows of [global nodes]: {start, stride, count, block} (io.h) */
+static void plane_pattern(const mpmc_grid *g, int a, long lo, long hi, size_t pat[4]) {
+  size_t inner = 1, outer = 1;
+  for (int b = 0; b < a; ++b) inner *= (size_t)g->ng[b];
+  for (int b = a + 1; b < 3; ++b) outer *= (size_t)g->ng[b];
+  pat[0] = inner * (size_t)lo;
+  pat[1] = inner * (size_t)g->ng[a];
+  pat[2] = outer;
+  pat[3] = inner * (size_t)(hi - lo);
+}
+
+/* Adaptive damping's node store as one dataset over the whole grid: in one process the
+ * rank's own; over MPI each rank writes the nodes of the planes it counts (damping.c: a node
+ * with mass last step holds the same values on every rank that has it; the ranks' planes
+ * cover the grid once), a hyperslab of its held nodes in their order (the other axes are
+ * whole): no rank holds the whole grid's store.  A restart on any number of ranks then
+ * finds every node's last force. */
+static herr_t write_adaptive_nodes(hid_t g, mpmc_const_sim sim) {
+  const mpmc_grid *gr = &sim->grid;
+  const size_t cols = (size_t)(1 + sim->cfg.dim), all = mpmc_grid_global_nodes(gr);
+  int own[3];
+  mpmc_adaptive_damping_own(sim, own);
+  if (own[0] < 0)
+    return mpmc_h5_dataset_write(g, "adaptive_damping_nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, all, cols,
+                                 sim->adr_f);
+  const int a = own[0];
+  size_t pat[4];
+  plane_pattern(gr, a, own[1] + gr->off[a], own[2] + gr->off[a], pat);
+  double *buf = malloc(sizeof *buf * cols * (pat[2] * pat[3] > 0 ? pat[2] * pat[3] : 1));
+  hid_t dxpl = mpmc_io_dxpl(sim);
+  if (mpmc_dd_agree(sim, buf && dxpl >= 0 ? MPMC_SUCCESS : MPMC_ERR_MEMORY)) {
+    free(buf);
+    mpmc_io_plist_close(dxpl);
+    return -1;
   }
-  mpmc_dd_sum_disjoint(sim, a, all); /* x + -0: the owner's values, exactly */
-  return a;
+  size_t k = 0;
+  for (size_t i = 0; i < gr->nn; ++i) {
+    const long pl = mpmc_grid_plane(gr, a, i);
+    if (pl >= own[1] && pl < own[2]) memcpy(buf + cols * k++, sim->adr_f + cols * i, sizeof *buf * cols);
+  }
+  const herr_t st = mpmc_h5_pattern_write(g, "adaptive_damping_nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, all,
+                                          cols, pat, buf, dxpl);
+  mpmc_io_plist_close(dxpl);
+  free(buf);
+  return st;
 }
 
 static int write_config(hid_t f, mpmc_const_sim sim) {
@@ -205,14 +231,7 @@ static int write_config(hid_t f, mpmc_const_sim sim) {
   const double ad[4] = {sim->cfg.adr ? sim->cfg.adr_zeta : 0.0, sim->adr_c, sim->adr_sum[0],
                         sim->adr_sum[1]};
   st |= mpmc_h5_attr_write(g, "adaptive_damping", H5T_NATIVE_DOUBLE, 4, ad);
-  if (sim->cfg.adr && sim->adr_nf) {
-    double *nodes = adaptive_nodes(sim);
-    if (!nodes) return -1;
-    st |= mpmc_h5_dataset_write(g, "adaptive_damping_nodes", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
-                                mpmc_grid_global_nodes(&sim->grid), (size_t)(1 + sim->cfg.dim),
-                                nodes);
-    if (nodes != sim->adr_f) free(nodes);
-  }
+  if (sim->cfg.adr && sim->adr_nf) st |= write_adaptive_nodes(g, sim);
   st |= mpmc_h5_attr_write(g, "time", H5T_NATIVE_DOUBLE, 1, &sim->time);
   st |= mpmc_h5_attr_write(g, "grid_lo", H5T_NATIVE_DOUBLE, 3, gr->lo);
   st |= mpmc_h5_attr_write(g, "grid_hi", H5T_NATIVE_DOUBLE, 3, gr->hi);
@@ -280,34 +299,34 @@ static int read_water_table(hid_t f, mpmc_sim sim) {
 }
 
 /* Adaptive damping's node store (config dataset adaptive_damping_nodes [nn][1 + dim], the
- * whole grid's nn, of which a rank keeps its held nodes; absent: the next step measures no
+ * whole grid's nn, of which a rank reads its held nodes alone: a hyperslab of the planes it
+ * holds along the one axis it does not hold whole; absent: the next step measures no
  * quotient). */
 static int read_adaptive_nodes(hid_t f, mpmc_sim sim) {
   hid_t g = H5Gopen2(f, "config", H5P_DEFAULT);
   if (g < 0) return MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT, "checkpoint has no /config group");
   int err = MPMC_SUCCESS;
   if (exists(g, "adaptive_damping_nodes")) {
-    const size_t cols = (size_t)(1 + sim->cfg.dim), all = mpmc_grid_global_nodes(&sim->grid),
-                 n = sim->grid.nn * cols;
-    double *a = malloc(all * cols * sizeof *a);
-    if (!a)
+    const mpmc_grid *gr = &sim->grid;
+    const size_t cols = (size_t)(1 + sim->cfg.dim), all = mpmc_grid_global_nodes(gr), n = gr->nn * cols;
+    int a = 0; /* the axis held in part (any, when the rank holds the whole grid) */
+    for (int b = 0; b < 3; ++b)
+      if (gr->n[b] != gr->ng[b]) a = b;
+    size_t pat[4];
+    plane_pattern(gr, a, gr->off[a], gr->off[a] + gr->n[a], pat);
+    double *buf = malloc(n * sizeof *buf);
+    if (!buf)
       err = MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "cannot allocate adaptive damping's node store");
-    else if (read_dataset(g, "adaptive_damping_nodes", H5T_NATIVE_DOUBLE, all, cols, a) < 0)
+    else if (mpmc_h5_pattern_read(g, "adaptive_damping_nodes", H5T_NATIVE_DOUBLE, all, cols, pat, buf) < 0)
       err = MPMC_ERROR(sim->ctx, MPMC_ERR_FORMAT,
                        "checkpoint /config: adaptive_damping_nodes is not [%zu][%zu] (the grid's "
                        "nodes)",
                        all, cols);
-    if (!err && n != all * cols) { /* over MPI: the rank's held nodes alone */
-      for (size_t i = 0; i < sim->grid.nn; ++i)
-        memmove(a + i * cols, a + mpmc_grid_global(&sim->grid, i) * cols, cols * sizeof *a);
-      double *s = realloc(a, n * sizeof *a);
-      a = s ? s : a;
-    }
     if (err) {
-      free(a);
+      free(buf);
     } else {
       free(sim->adr_f);
-      sim->adr_f = a;
+      sim->adr_f = buf;
       sim->adr_nf = n;
     }
   }

@@ -74,20 +74,26 @@ int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow) {
     sim->scr.adr_rows = r;
     sim->scr.adr_nrows = (size_t)nrow;
   }
-  sim->adr_own[0] = -1;
+  mpmc_adaptive_damping_own(sim, sim->adr_own);
+  return MPMC_SUCCESS;
+}
+
+void mpmc_adaptive_damping_own(const struct mpmc_sim_s *sim, int own[3]) {
+  own[0] = -1;
 #ifdef MPMC_HAVE_MPI
   /* over MPI a halo node holds the same sums on both ranks (mpi.c): it counts on the rank
    * whose slab holds the cell above it, the top plane on the last rank; planes of the held
-   * nodes (grid.off) */
+   * nodes (grid.off).  The ranks' planes cover the grid's, each once. */
   int rank, nranks, axis, lo, hi;
   if (sim->dd && !mpmc_sim_get_mpi_slab(sim, &rank, &nranks, &axis, &lo, &hi)) {
     const int off = sim->grid.off[axis]; /* the held nodes' planes */
-    sim->adr_own[0] = axis;
-    sim->adr_own[1] = lo - off;
-    sim->adr_own[2] = (rank == nranks - 1 ? sim->grid.ng[axis] : hi) - off;
+    own[0] = axis;
+    own[1] = lo - off;
+    own[2] = (rank == nranks - 1 ? sim->grid.ng[axis] : hi) - off;
   }
+#else
+  (void)sim;
 #endif
-  return MPMC_SUCCESS;
 }
 
 void mpmc_adaptive_damping_finish(struct mpmc_sim_s *sim, long nrow) {

@@ -25,6 +25,14 @@ herr_t mpmc_h5_attr_read_string(hid_t loc, const char *name, char **s);
 /* A dataset [rows][cols] (cols == 0: 1-D) of type memtype from buf. */
 herr_t mpmc_h5_dataset_write(hid_t loc, const char *name, hid_t filetype, hid_t memtype,
                              size_t rows, size_t cols, const void *buf);
+/* Rows of a [rows][cols] dataset in a regular pattern, pat = {start, stride, count, block}:
+ * the rows start + stride i + j, i < count, j < block (a slab of planes of a grid's nodes, one
+ * block a row of planes), in that order in buf.  Write: the dataset made (collectively over
+ * MPI, every rank with its own pattern and dxpl); read: the dataset must be [rows][cols]. */
+herr_t mpmc_h5_pattern_write(hid_t loc, const char *name, hid_t filetype, hid_t memtype, size_t rows,
+                             size_t cols, const size_t pat[4], const void *buf, hid_t dxpl);
+herr_t mpmc_h5_pattern_read(hid_t loc, const char *name, hid_t memtype, size_t rows, size_t cols,
+                            const size_t pat[4], void *buf);
 /* Make the file's bytes durable: fsync(path) and its directory. */
 int mpmc_fsync_path(const char *path);
 

@@ -121,6 +121,44 @@ herr_t mpmc_h5_rows_write(hid_t loc, const char *name, hid_t filetype, hid_t mem
   return st;
 }
 
+/* pat's rows of a [rows][cols] space selected, and a memory space of them */
+static herr_t select_pattern(hid_t space, size_t cols, const size_t pat[4], hid_t *mem) {
+  const hsize_t start[2] = {(hsize_t)pat[0], 0}, stride[2] = {(hsize_t)(pat[1] > 0 ? pat[1] : 1), 1},
+                count[2] = {(hsize_t)pat[2], 1}, block[2] = {(hsize_t)pat[3], (hsize_t)cols},
+                n[2] = {(hsize_t)(pat[2] * pat[3]), (hsize_t)cols};
+  *mem = H5Screate_simple(2, n, NULL);
+  return *mem < 0 ? -1 : H5Sselect_hyperslab(space, H5S_SELECT_SET, start, stride, count, block);
+}
+
+herr_t mpmc_h5_pattern_write(hid_t loc, const char *name, hid_t filetype, hid_t memtype, size_t rows,
+                             size_t cols, const size_t pat[4], const void *buf, hid_t dxpl) {
+  const hsize_t dims[2] = {(hsize_t)rows, (hsize_t)cols};
+  hid_t space = H5Screate_simple(2, dims, NULL), mem = -1;
+  hid_t ds = space < 0 ? -1 : H5Dcreate2(loc, name, filetype, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  herr_t st = ds < 0 ? -1 : select_pattern(space, cols, pat, &mem);
+  if (st >= 0) st = H5Dwrite(ds, memtype, mem, space, dxpl, buf);
+  if (mem >= 0) H5Sclose(mem);
+  if (ds >= 0) H5Dclose(ds);
+  if (space >= 0) H5Sclose(space);
+  return st;
+}
+
+herr_t mpmc_h5_pattern_read(hid_t loc, const char *name, hid_t memtype, size_t rows, size_t cols,
+                            const size_t pat[4], void *buf) {
+  hid_t ds = H5Lexists(loc, name, H5P_DEFAULT) > 0 ? H5Dopen2(loc, name, H5P_DEFAULT) : -1;
+  hid_t space = ds < 0 ? -1 : H5Dget_space(ds), mem = -1;
+  hsize_t dims[2] = {0, 0};
+  herr_t st = space >= 0 && H5Sget_simple_extent_ndims(space) == 2 ? 0 : -1;
+  if (st >= 0) H5Sget_simple_extent_dims(space, dims, NULL);
+  if (st >= 0 && (dims[0] != rows || dims[1] != cols)) st = -1;
+  if (st >= 0) st = select_pattern(space, cols, pat, &mem);
+  if (st >= 0) st = H5Dread(ds, memtype, mem, space, H5P_DEFAULT, buf);
+  if (mem >= 0) H5Sclose(mem);
+  if (space >= 0) H5Sclose(space);
+  if (ds >= 0) H5Dclose(ds);
+  return st;
+}
+
 int mpmc_fsync_path(const char *path) {
   int fd = open(path, O_RDONLY);
   if (fd < 0) return -1;

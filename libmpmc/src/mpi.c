@@ -59,9 +59,6 @@ int mpmc_dd_setup(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
 int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) { return (void)sim, (void)x, 1; }
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) { (void)sim, (void)v, (void)n; }
-void mpmc_dd_sum_disjoint(const struct mpmc_sim_s *sim, double *v, size_t n) {
-  (void)sim, (void)v, (void)n;
-}
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v) { return (void)sim, (void)v, 1; }
 void mpmc_dd_minloc(const struct mpmc_sim_s *sim, double *v, int *id) { (void)sim, (void)v, (void)id; }
 void mpmc_dd_free(struct mpmc_sim_s *sim) { (void)sim; }
@@ -336,14 +333,6 @@ void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n) {
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n) {
   if (!sim->dd || n <= 0) return;
   MPI_Allreduce(MPI_IN_PLACE, v, n, MPI_DOUBLE, MPI_MAX, sim->dd->comm);
-}
-
-void mpmc_dd_sum_disjoint(const struct mpmc_sim_s *sim, double *v, size_t n) {
-  if (!sim->dd) return;
-  for (size_t k = 0; k < n; k += INT_MAX / 2) { /* MPI counts are ints */
-    const size_t len = n - k < INT_MAX / 2 ? n - k : INT_MAX / 2;
-    MPI_Allreduce(MPI_IN_PLACE, v + k, (int)len, MPI_DOUBLE, MPI_SUM, sim->dd->comm);
-  }
 }
 
 /* 1 on the lowest rank whose v is the largest over the ranks, 0 on the others. */

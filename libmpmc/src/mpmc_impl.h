@@ -634,6 +634,9 @@ void mpmc_kinetic_damping(struct mpmc_sim_s *sim);
  * after it the new coefficient from the rows' sums (damping.c). */
 int mpmc_adaptive_damping_prepare(struct mpmc_sim_s *sim, long nrow);
 void mpmc_adaptive_damping_finish(struct mpmc_sim_s *sim, long nrow);
+/* Over MPI the slab axis and the held node planes [own[1], own[2]) whose sums this rank
+ * counts (the ranks' planes cover the grid's, each once); own[0] = -1 in one process. */
+void mpmc_adaptive_damping_own(const struct mpmc_sim_s *sim, int own[3]);
 double mpmc_stability_limit(const struct mpmc_sim_s *sim, double factor);
 void mpmc_return_map_free(struct mpmc_sim_s *sim);
 /* contact_barrier.c: fill p->cforce before P2G (only called when sim->bodies is set), the
@@ -681,9 +684,6 @@ int mpmc_dd_balance_due(struct mpmc_sim_s *sim);
 /* v[0 .. n) summed over the ranks in rank order (the same bits on every rank) / maximum */
 void mpmc_dd_sum(const struct mpmc_sim_s *sim, double *v, int n);
 void mpmc_dd_max(const struct mpmc_sim_s *sim, double *v, int n);
-/* v[0 .. n) summed over the ranks where one rank holds an entry's value and the others -0
- * (-0 + x = x in any order: the same bits without mpmc_dd_sum's gather of every rank's v) */
-void mpmc_dd_sum_disjoint(const struct mpmc_sim_s *sim, double *v, size_t n);
 /* 1 on the (lowest) rank whose v is the largest */
 int mpmc_dd_owner(const struct mpmc_sim_s *sim, double v);
 /* the least v over the ranks and, of the ranks that have it, the least id (collective);
