@@ -33,35 +33,66 @@ static void lap(mpmc_sim sim, int ph, double *t) {
   sim->stats.phase_seconds[ph] += t1 - *t;
   *t = t1;
 }
-/* Over MPI every phase ends with the ranks' agreement (mpi.c, mpmc_dd_agree): a failure
- * on one rank fails the step on all with the same message before anyone waits in an
- * exchange; in one process (sim->dd NULL) the call's code as it is. */
-#define PHASE(sim, ph, t, call)                                  \
-  do {                                                           \
-    int phase_err_ = (call);                                     \
-    if ((sim)->dd) phase_err_ = mpmc_dd_agree(sim, phase_err_);  \
-    if (phase_err_) return phase_err_;                           \
-    lap(sim, ph, t);                                             \
+/* Over MPI the ranks agree on a failure (mpi.c, mpmc_dd_agree) where every rank must take
+ * part (an exchange with the neighbours, a sum over the ranks inside a phase) and at the
+ * step's end, not after every phase: a rank whose phase fails skips its phases up to that
+ * agreement, so no rank waits in an exchange or a sum that a failed rank does not reach, and
+ * every rank fails the step with the same message.  In one process (sim->dd NULL) a failing
+ * phase returns at once.  Each agreement's wait counts to phase ph. */
+#define PHASE(sim, ph, t, call)            \
+  do {                                     \
+    if (!err_) {                           \
+      err_ = (call);                       \
+      lap(sim, ph, t);                     \
+    }                                      \
+    if (err_ && !(sim)->dd) return err_;   \
+  } while (0)
+#define AGREE(sim, ph, t)                                 \
+  do {                                                    \
+    if ((sim)->dd) {                                      \
+      err_ = mpmc_dd_agree(sim, err_);                    \
+      lap(sim, ph, t);                                    \
+    }                                                     \
+    if (err_) return err_;                                \
   } while (0)
 
 static int step_phases(mpmc_sim sim, double dt, double *t) {
   const mpmc_kernel_set *k = mpmc_kernels_of(sim);
+  int err_ = MPMC_SUCCESS;
   if (sim->bodies) PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_update(sim, dt)); /* barrier forces */
   mpmc_grid_clear_active(&sim->grid); /* the last step's box: the rest is zero already */
   if (sim->cfg.fbar) mpmc_fbar_clear(sim, MPMC_FBAR_CLEAR_BOX); /* its F-bar sums too */
   PHASE(sim, MPMC_PHASE_SLABS, t, k->slabs(sim));     /* this step's box, P2G's colouring */
   PHASE(sim, MPMC_PHASE_P2G, t, k->p2g(sim, dt));     /* mass, momentum, forces   (eqs 7, 8, 10) */
-  if (sim->dd) PHASE(sim, MPMC_PHASE_P2G, t, mpmc_dd_halo(sim, MPMC_DD_NODES)); /* MPI: halo sums */
+  if (sim->dd) { /* MPI: halo sums */
+    AGREE(sim, MPMC_PHASE_P2G, t);
+    PHASE(sim, MPMC_PHASE_P2G, t, mpmc_dd_halo(sim, MPMC_DD_NODES));
+  }
+  if (sim->cfg.adr) AGREE(sim, MPMC_PHASE_P2G, t); /* adaptive damping sums over the ranks */
   PHASE(sim, MPMC_PHASE_GRID, t, k->grid_update(sim, dt)); /* velocities, walls, damping (eq 9) */
   PHASE(sim, MPMC_PHASE_G2P, t, k->g2p(sim, dt));     /* v, dF, J, x              (eqs 13-17)    */
-  if (sim->cfg.kdamp) mpmc_kinetic_damping(sim);          /* v = 0 at a peak of E_k (damping.c) */
-  if (sim->cfg.fbar && sim->dd) PHASE(sim, MPMC_PHASE_FBAR, t, mpmc_dd_halo(sim, MPMC_DD_FBAR));
+  if (sim->cfg.kdamp) { /* v = 0 at a peak of E_k (damping.c; E_k over the ranks) */
+    AGREE(sim, MPMC_PHASE_G2P, t);
+    mpmc_kinetic_damping(sim);
+  }
+  if (sim->cfg.fbar && sim->dd) {
+    AGREE(sim, MPMC_PHASE_G2P, t);
+    PHASE(sim, MPMC_PHASE_FBAR, t, mpmc_dd_halo(sim, MPMC_DD_FBAR));
+  }
   if (sim->cfg.fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim, 1)); /* dF -> dF-bar (Alg. 1, 2-4)   */
   PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar);
                                    the built-in materials run F-bar's gather themselves */
-  if (sim->bodies) PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_check(sim)); /* no point inside a body */
+  if (sim->bodies) { /* no point inside a body (sums over the ranks) */
+    AGREE(sim, MPMC_PHASE_STRESS, t);
+    PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_check(sim));
+  }
+  AGREE(sim, MPMC_PHASE_STRESS, t); /* the monitor's sums over the ranks */
   PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_monitor_step(sim)); /* NaN velocity, energy growth */
-  if (sim->dd) PHASE(sim, MPMC_PHASE_SORT, t, mpmc_dd_migrate(sim)); /* MPI: points to their slabs */
+  if (sim->dd) { /* MPI: points to their slabs */
+    AGREE(sim, MPMC_PHASE_CHECKS, t);
+    PHASE(sim, MPMC_PHASE_SORT, t, mpmc_dd_migrate(sim));
+    AGREE(sim, MPMC_PHASE_SORT, t);
+  }
   return MPMC_SUCCESS;
 }
 
