@@ -160,6 +160,15 @@ mpmc_mpi_scene_test(slope_2d 3 slope_2d.yaml "runout_distance" 1e-6 1e-9
 # on the same step as in one process
 mpmc_mpi_scene_test(slope_2d_adaptive 3 slope_2d.yaml "runout_distance" 1e-6 1e-9
   "--set grid.cell_size=0.5 --set stages.gravity.adaptive_damping=true --set stages.gravity.damping=0 --set stages.gravity.end.min_time=0 --set stages.strength_reduction.end.time=0.001 --set stages.runout.end.time=0.2")
+# shipped scenes at their CI size (SCENE.expected.yaml's sets) on 3 ranks: Cook's membrane (its
+# load stage ends on the kinetic energy), the quick clay (KINSOL's fallbacks), the slope with
+# a water table and its factor of safety
+mpmc_mpi_scene_test(cook_membrane 3 cook_membrane.yaml "tip_displacement_y;tip_displacement_x" 1e-6 1e-9
+  "--set grid.cell_size=2 --set plots=false")
+mpmc_mpi_scene_test(slope_2d_quick_clay 3 slope_2d_quick_clay.yaml "runout_distance" 1e-6 1e-9
+  "--set grid.cell_size=0.5 --set stages.runout.end.time=1.0 --set plots=false")
+mpmc_mpi_scene_test(slope_arai_tagyo_water 3 slope_arai_tagyo_water.yaml "factor_of_safety" 0 0
+  "--set grid.cell_size=2.0")
 # `mpmc fos` over the ranks: the same trials and factor (slope_2d_fos at 0.5 m, 4 trials)
 mpmc_mpi_scene_test(slope_2d_fos 2 slope_2d_fos.yaml "factor_of_safety" 0 0
   "--set grid.cell_size=0.5 --set stages.fos.factor_of_safety.lo=1.3 --set stages.fos.factor_of_safety.hi=1.45 --set stages.fos.factor_of_safety.tolerance=0.06"
