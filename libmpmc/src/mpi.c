@@ -931,6 +931,14 @@ static int clear_of_mirrors(const struct mpmc_sim_s *sim, int c, int lo, int hi)
   return -1;
 }
 
+/* The nodes of the new cuts' slab, then every point to its new owner (collective). */
+static int recut(struct mpmc_sim_s *sim) {
+  int err = hold_slab(sim); /* the new slab's nodes, made before the step's phases */
+  if (!err) err = mpmc_sim_prepare(sim);
+  err = mpmc_dd_agree(sim, err);
+  return err ? err : migrate(sim, 1);
+}
+
 /* New cuts that split the points evenly (whole cells, slabs of MPMC_DD_MIN_CELLS or more,
  * clear of mirrored walls), then every point to its new owner (collective). */
 static int balance(struct mpmc_sim_s *sim) {
@@ -969,17 +977,41 @@ static int balance(struct mpmc_sim_s *sim) {
   free(nc);
   if (!ok || same) return MPMC_SUCCESS; /* no better cuts (or none the walls allow) */
   dd->bal_count++;
-  err = hold_slab(sim); /* the new slab's nodes, made before the step's phases */
-  if (!err) err = mpmc_sim_prepare(sim);
-  err = mpmc_dd_agree(sim, err);
-  return err ? err : migrate(sim, 1);
+  return recut(sim);
 }
 
-/* Before a step: balance if due (mpmc_sim_set_mpi_balance; collective). */
+/* The cuts moved out of the reach of the walls mirrored along the slab axis, each the least
+ * way (clear_of_mirrors), when the walls have changed: a wall on a node plane near a cut
+ * (a scene's floor, a slab thin at its CI size on 4 ranks) is not refused (check_mirrors)
+ * while a slab boundary clear of it exists.  Every rank holds every wall: the same cuts on
+ * each (collective). */
+static int clear_cuts(struct mpmc_sim_s *sim) {
+  struct mpmc_dd_s *dd = sim->dd;
+  if (!sim->scr.walls_dirty) return MPMC_SUCCESS; /* the cuts were cleared for these walls */
+  MPMC_CALL(mpmc_boundary_apply_flags(sim)); /* the mirrors */
+  const int P = dd->size, cells = dd->cut[P];
+  int *nc = malloc(sizeof(int) * (size_t)(P + 1)), ok = nc != NULL, same = 1;
+  MPMC_CALL(mpmc_dd_agree(sim, ok ? MPMC_SUCCESS : MPMC_ERROR(sim->ctx, MPMC_ERR_MEMORY, "no memory for the cuts")));
+  nc[0] = 0;
+  nc[P] = cells;
+  for (int r = 1; r < P && ok; ++r) {
+    const int lo = nc[r - 1] + MPMC_DD_MIN_CELLS, hi = cells - MPMC_DD_MIN_CELLS * (P - r);
+    nc[r] = clear_of_mirrors(sim, dd->cut[r] < lo ? lo : dd->cut[r], lo, hi);
+    ok = nc[r] >= 0;
+    same &= nc[r] == dd->cut[r];
+  }
+  if (ok && !same) memcpy(dd->cut, nc, sizeof(int) * (size_t)(P + 1));
+  free(nc);
+  return !ok || same ? MPMC_SUCCESS : recut(sim); /* none clear: check_mirrors says so */
+}
+
+/* Before a step: the cuts clear of new walls, and a balance if due (mpmc_sim_set_mpi_balance;
+ * collective). */
 int mpmc_dd_balance_due(struct mpmc_sim_s *sim) {
   struct mpmc_dd_s *dd = sim->dd;
-  if (!dd || dd->size == 1 || dd->axis < 0 || (!dd->bal_every && !(dd->bal_threshold > 0)))
-    return MPMC_SUCCESS;
+  if (!dd || dd->size == 1 || dd->axis < 0) return MPMC_SUCCESS;
+  MPMC_CALL(clear_cuts(sim));
+  if (!dd->bal_every && !(dd->bal_threshold > 0)) return MPMC_SUCCESS;
   int due = dd->bal_every > 0 && sim->stats.steps - dd->bal_last >= dd->bal_every;
   if (!due && dd->bal_threshold > 0) due = imbalance(sim) > dd->bal_threshold;
   if (!due) return MPMC_SUCCESS;
