@@ -167,13 +167,6 @@ int mpmc_grid_alloc(mpmc_context ctx, mpmc_grid *g);
  * whole): frees the node arrays when the span changes (mpmc_grid_alloc makes them anew) and
  * returns 1, else 0.  Over MPI (mpi.c) a rank's slab and halo. */
 int mpmc_grid_span(mpmc_grid *g, int a, int lo, int hi);
-/* the whole grid's index of held node i */
-static inline size_t mpmc_grid_global(const mpmc_grid *g, size_t i) {
-  const size_t n0 = (size_t)g->n[0], n1 = (size_t)g->n[1];
-  const size_t x = i % n0 + (size_t)g->off[0], y = i / n0 % n1 + (size_t)g->off[1],
-               z = i / (n0 * n1) + (size_t)g->off[2];
-  return x + (size_t)g->ng[0] * (y + (size_t)g->ng[1] * z);
-}
 /* the whole grid's nodes */
 static inline size_t mpmc_grid_global_nodes(const mpmc_grid *g) {
   return (size_t)g->ng[0] * (size_t)g->ng[1] * (size_t)g->ng[2];
