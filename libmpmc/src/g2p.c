@@ -333,6 +333,31 @@ static int report(mpmc_sim sim, int q) {
                     (long long)sim->stats.steps, sim->time, nb, x[0], x[1], d == 3 ? x[2] : 0.0);
 }
 
+/* Over MPI G2P's box along the slab axis is the rank's slab (mpmc_dd_slab_box), so that the
+ * kernels' check also finds the points that left it, at no cost a point: of the points from
+ * first, the first kernel's one, on, the first that fails the step (a degenerate dF, or out
+ * of the grid's box lo, hi), or -1; whether any lies beyond the slab's box (xmin, xmax)
+ * goes to the migration (mpmc_dd_leaving). */
+static int slab_exits(mpmc_sim sim, int first, const double *lo, const double *hi,
+                      const double *xmin, const double *xmax) {
+  const mpmc_particles *p = &sim->p;
+  const int d = sim->cfg.dim;
+  int beyond = 0;
+  for (int q = first; q < p->n; ++q) {
+    const double *x = p->x + (size_t)q * d, *dF = p->dF + (size_t)q * d * d;
+    const double dJ = d == 2 ? mpmc_det_dim(2, dF) : mpmc_det_dim(3, dF);
+    int ok = dJ > 0.0 && isfinite(dJ), in = 1;
+    for (int a = 0; a < d; ++a) {
+      ok &= (x[a] >= lo[a]) & (x[a] <= hi[a]);
+      in &= (x[a] >= xmin[a]) & (x[a] <= xmax[a]);
+    }
+    if (!ok) return q;
+    beyond |= !in;
+  }
+  mpmc_dd_leaving(sim, beyond);
+  return -1;
+}
+
 /** Phase 3 of the step. */
 int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   const mpmc_grid *g = &sim->grid;
@@ -340,9 +365,14 @@ int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   g2p_ctx c = {.eta = D > 0 ? 1.0 - fmin(1.0, D * dt * g->inv_h * g->inv_h) : sim->cfg.flip,
                .travel_scale = dt * g->inv_h,
                .xold = sim->cfg.fbar == MPMC_FBAR_STABLE ? sim->fb.xn : NULL};
+  double lo[3], hi[3]; /* the grid's box */
   for (int a = 0; a < sim->cfg.dim; ++a) {
-    c.xmin[a] = g->lo[a] - g->h;
-    c.xmax[a] = g->hi[a] + g->h;
+    c.xmin[a] = lo[a] = g->lo[a] - g->h;
+    c.xmax[a] = hi[a] = g->hi[a] + g->h;
+  }
+  if (sim->dd) {
+    mpmc_dd_slab_box(sim, c.xmin, c.xmax);
+    mpmc_dd_leaving(sim, 0);
   }
   int bad = -1;
   double v2max = 0.0;
@@ -356,6 +386,7 @@ int MPMC_ISA(mpmc_g2p)(mpmc_sim sim, double dt) {
   } else {
     MPMC_KERNEL_CALL(g2p_, sim, sim, dt, &c, &bad, &v2max);
   }
+  if (bad >= 0 && sim->dd) bad = slab_exits(sim, bad, lo, hi, c.xmin, c.xmax);
   /* the stability limit's max |v|^2 (stability.c), unless v is on loan to a caller */
   sim->scr.v2max = v2max;
   sim->scr.v2max_ok = bad < 0 && !sim->v_borrowed;

@@ -54,6 +54,11 @@
 int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err) { return (void)sim, err < 0 ? MPMC_SUCCESS : err; }
 int mpmc_dd_halo(struct mpmc_sim_s *sim, int what) { return (void)sim, (void)what, MPMC_SUCCESS; }
 int mpmc_dd_migrate(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
+void mpmc_dd_slab_box(const struct mpmc_sim_s *sim, double *xmin, double *xmax) { (void)sim, (void)xmin, (void)xmax; }
+void mpmc_dd_leaving(struct mpmc_sim_s *sim, int any) { (void)sim, (void)any; }
+int mpmc_dd_agree_leaving(struct mpmc_sim_s *sim, int err, int *any) {
+  return (void)sim, *any = 0, err < 0 ? MPMC_SUCCESS : err;
+}
 int mpmc_dd_balance_due(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
 int mpmc_dd_setup(struct mpmc_sim_s *sim) { return (void)sim, MPMC_SUCCESS; }
 int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) { return (void)sim, (void)x, 1; }
@@ -90,6 +95,7 @@ struct mpmc_dd_s {
   double bal_threshold;
   long long bal_last;
   long bal_count;
+  int leaving;        /* this step's G2P moved a point beyond the slab's box (mpmc_dd_slab_box) */
 };
 
 enum { TAG_HALO = 4701, TAG_MIGRATE_N = 4702, TAG_MIGRATE = 4703 };
@@ -274,14 +280,17 @@ int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x) {
 
 /* ---- agreement and reductions --------------------------------------------------------- */
 
-int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err) {
+/* mpmc_dd_agree, and with any (not NULL) in the same reduction whether *any is set on some
+ * rank, into *any on every rank */
+static int agree(const struct mpmc_sim_s *sim, int err, int *any) {
   struct mpmc_dd_s *dd = sim->dd;
-  if (!dd) return err < 0 ? MPMC_SUCCESS : err;
   /* a real failure first, then a follower's (MPMC_DD_FOLLOW: a rank that knows the run
    * fails but leaves the message to the rank that has the point), lowest rank first */
   const int key = err > 0 ? dd->rank : err < 0 ? dd->size + dd->rank : 2 * dd->size;
-  int root = 0;
-  MPI_Allreduce(&key, &root, 1, MPI_INT, MPI_MIN, dd->comm);
+  int in[2] = {key, any && *any ? 0 : 1}, out[2] = {0, 1};
+  MPI_Allreduce(in, out, any ? 2 : 1, MPI_INT, MPI_MIN, dd->comm);
+  if (any) *any = !out[1];
+  int root = out[0];
   if (root == 2 * dd->size) return MPMC_SUCCESS;
   root %= dd->size;
   mpmc_context ctx = sim->ctx;
@@ -300,6 +309,37 @@ int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err) {
   ctx->last_code = code;
   memcpy(ctx->last_msg, msg, MPMC_MSG_LEN);
   return code;
+}
+
+int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err) {
+  if (!sim->dd) return err < 0 ? MPMC_SUCCESS : err;
+  return agree(sim, err, NULL);
+}
+
+/* The step's agreement before migration: the error as mpmc_dd_agree, and *any whether a
+ * point on some rank left its slab's box in this step's G2P (mpmc_dd_leaving). */
+int mpmc_dd_agree_leaving(struct mpmc_sim_s *sim, int err, int *any) {
+  *any = sim->dd ? sim->dd->leaving : 0;
+  if (!sim->dd) return err < 0 ? MPMC_SUCCESS : err;
+  return agree(sim, err, any);
+}
+
+/* G2P's box (g2p.c: a point beyond it fails the step) narrowed along the slab axis to this
+ * rank's slab less a millionth of a cell, except at the grid's ends: a point still inside
+ * has not left the slab (its cell, slab_cell's floor, is the slab's), one beyond it may
+ * have; G2P then tells which (mpmc_dd_leaving), and only then do the ranks migrate. */
+void mpmc_dd_slab_box(const struct mpmc_sim_s *sim, double *xmin, double *xmax) {
+  const struct mpmc_dd_s *dd = sim->dd;
+  if (!dd || dd->size == 1 || dd->axis < 0) return;
+  const mpmc_grid *g = &sim->grid;
+  const int a = dd->axis, lo = dd->cut[dd->rank], hi = dd->cut[dd->rank + 1];
+  const double tol = 1e-6 * g->h;
+  if (lo > 0) xmin[a] = g->origin[a] + lo * g->h + tol;
+  if (hi < g->ng[a] - 1) xmax[a] = g->origin[a] + hi * g->h - tol;
+}
+
+void mpmc_dd_leaving(struct mpmc_sim_s *sim, int any) {
+  if (sim->dd) sim->dd->leaving = any;
 }
 
 /* v[0 .. n) summed over the ranks in rank order on every rank: the same bits everywhere

@@ -672,6 +672,12 @@ int mpmc_dd_keep(const struct mpmc_sim_s *sim, const double *x);
 int mpmc_dd_agree(const struct mpmc_sim_s *sim, int err);
 int mpmc_dd_halo(struct mpmc_sim_s *sim, int what);
 int mpmc_dd_migrate(struct mpmc_sim_s *sim);
+/* G2P's box narrowed to this rank's slab along its axis: beyond it a point may have left */
+void mpmc_dd_slab_box(const struct mpmc_sim_s *sim, double *xmin, double *xmax);
+/* G2P's finding: some point of this rank went beyond that box this step (any = 1) or none */
+void mpmc_dd_leaving(struct mpmc_sim_s *sim, int any);
+/* collective: mpmc_dd_agree, and *any = whether G2P found such a point on some rank */
+int mpmc_dd_agree_leaving(struct mpmc_sim_s *sim, int err, int *any);
 /* before a step: move the cuts and the points if a balance is due (collective) */
 int mpmc_dd_balance_due(struct mpmc_sim_s *sim);
 /* v[0 .. n) summed over the ranks in rank order (the same bits on every rank) / maximum */

@@ -88,10 +88,15 @@ static int step_phases(mpmc_sim sim, double dt, double *t) {
   }
   AGREE(sim, MPMC_PHASE_STRESS, t); /* the monitor's sums over the ranks */
   PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_monitor_step(sim)); /* NaN velocity, energy growth */
-  if (sim->dd) { /* MPI: points to their slabs */
-    AGREE(sim, MPMC_PHASE_CHECKS, t);
-    PHASE(sim, MPMC_PHASE_SORT, t, mpmc_dd_migrate(sim));
-    AGREE(sim, MPMC_PHASE_SORT, t);
+  if (sim->dd) { /* MPI: points to their slabs, in a step where some left theirs (g2p.c) */
+    int any = 0;
+    err_ = mpmc_dd_agree_leaving(sim, err_, &any);
+    lap(sim, MPMC_PHASE_CHECKS, t);
+    if (err_) return err_;
+    if (any) {
+      PHASE(sim, MPMC_PHASE_SORT, t, mpmc_dd_migrate(sim));
+      AGREE(sim, MPMC_PHASE_SORT, t);
+    }
   }
   return MPMC_SUCCESS;
 }
