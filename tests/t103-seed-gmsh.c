@@ -3,7 +3,8 @@
  * points; its clamped edge (44 m) holds 44 / 0.5 = 88 points of the first column, its
  * traction edge (16 m) 32, and the tip (48, 60) is nearest to the lattice point
  * (47.75, 59.75).  Quadrature volumes sum to the mesh area to round-off.  The 2D slope's
- * area is 5 * 9.95 + 5 * 5 / 2 = 62.25 m^2. */
+ * area is 5 * 9.95 + 5 * 5 / 2 = 62.25 m^2.  Seeding leaves the caller's OpenMP thread count
+ * as it was (gmsh sets its own on initialising). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -11,6 +12,7 @@
 #include <string.h>
 
 #include <cmocka.h>
+#include <omp.h>
 
 #include "test_util.h"
 #include "mpmc_gmsh.h"
@@ -157,12 +159,30 @@ static void test_bad_input(void **state) {
   remove(empty);
 }
 
+/* gmshInitialize and gmshFinalize set OpenMP's threads to gmsh's General.NumThreads (1): a
+ * scene seeded from gmsh then stepped on one thread whatever the cores or OMP_NUM_THREADS. */
+static void test_threads_kept(void **state) {
+  (void)state;
+  int mat, first, count;
+  const double lo[2] = {0, 0}, hi[2] = {50, 62};
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(3);
+  mpmc_sim sim = make(2, lo, hi, 1.0, &mat);
+  TCALL(mpmc_seed_gmsh(sim, MESH("cook_membrane.geo"), "membrane", MPMC_SEED_LATTICE, 1, mat,
+                       &first, &count));
+  const int after = omp_get_max_threads();
+  omp_set_num_threads(before);
+  mpmc_sim_destroy(&sim);
+  if (after != 3) fail_msg("OpenMP threads 3 before seeding from gmsh, %d after", after);
+}
+
 int main(void) {
   mpmc_context_create(&ctx);
   test_ctx = ctx;
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_cook_lattice),
                                      cmocka_unit_test(test_quadrature),
-                                     cmocka_unit_test(test_bad_input)};
+                                     cmocka_unit_test(test_bad_input),
+                                     cmocka_unit_test(test_threads_kept)};
   const int r = cmocka_run_group_tests(tests, NULL, NULL);
   mpmc_context_destroy(&ctx);
   return r;

@@ -16,6 +16,9 @@
 #include <unistd.h>
 
 #include <gmshc.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "seed.h"
 
@@ -25,7 +28,21 @@ typedef struct {
   mpmc_context ctx;
   const char *file;
   int up;
+  int threads; /* the caller's OpenMP threads, which gmsh sets to its General.NumThreads */
 } session;
+
+/* gmshInitialize and gmshFinalize set the process's OpenMP threads to gmsh's own count (1):
+ * the caller's (OMP_NUM_THREADS, the cores, or its omp_set_num_threads) are put back. */
+static void keep_threads(session *s, int save) {
+#ifdef _OPENMP
+  if (save)
+    s->threads = omp_get_max_threads();
+  else if (s->threads > 0)
+    omp_set_num_threads(s->threads);
+#else
+  (void)s, (void)save;
+#endif
+}
 
 /* The last error gmsh logged (e.g. "'x.geo', line 3 : syntax error (...)"), or "". */
 static void gmsh_last_error(char *buf, size_t len) {
@@ -56,6 +73,7 @@ static void session_end(session *s) {
   if (!s->up) return;
   gmshLoggerStop(&ierr);
   gmshFinalize(&ierr);
+  keep_threads(s, 0);
   s->up = 0;
 }
 
@@ -223,7 +241,9 @@ static int session_open(session *s, int dim) {
   char dir[512] = "", msh[600] = "";
   const int geo = !has_suffix(s->file, ".msh");
   if (geo) MPMC_CALL(mesh_in_child(s, dim, dir, sizeof dir, msh, sizeof msh));
+  keep_threads(s, 1);
   gmshInitialize(0, NULL, 0, &ierr);
+  keep_threads(s, 0);
   if (ierr) {
     if (geo) drop_mesh_dir(dir, msh);
     return MPMC_ERROR(s->ctx, MPMC_ERR_UNSUPPORTED, "gmsh: cannot initialise the gmsh library");
@@ -848,7 +868,7 @@ int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, mpmc_seed
   /* gmsh 4.8 opens a missing file "successfully" into an empty model */
   MPMC_CHECK(access(file, R_OK) == 0, ctx, MPMC_ERR_IO, "gmsh: cannot read '%s': %s", file,
              strerror(errno));
-  session s = {ctx, file, 0};
+  session s = {ctx, file, 0, 0};
   nodes nd = {NULL, 0};
   pgroup *groups = NULL;
   size_t ngroup = 0;
