@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -221,6 +222,27 @@ void wf_par_plan(mpmc_sim sim, char *line, size_t len) {
 #endif
   snprintf(line, len, "MPI: %d ranks x %d threads, slabs of grid cells along %c (rank 0: cells %d to %d)", nranks,
            threads, "xyz"[axis], lo, hi - 1);
+}
+
+int wf_par_threads(void) {
+  if (!distributed()) return 0;
+  MPI_Comm node;
+  int local = 1;
+  if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node) == MPI_SUCCESS) {
+    MPI_Comm_size(node, &local);
+    MPI_Comm_free(&node);
+  }
+#ifdef _OPENMP
+  const char *env = getenv("OMP_NUM_THREADS");
+  if (env && env[0]) return 0; /* the user's choice */
+  const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+  const int mine = omp_get_max_threads(); /* the cores this rank may run on (its binding) */
+  long t = cores > 0 ? cores / local : 1;
+  if (t > mine) t = mine;
+  return t < 1 ? 1 : (int)t;
+#else
+  return 0;
+#endif
 }
 
 int wf_par_balance(mpmc_sim sim, int every, double threshold) {
@@ -424,6 +446,7 @@ void wf_root_release(void) {
 #else /* one process: the library's arrays as they are */
 
 int wf_par_size(void) { return 1; }
+int wf_par_threads(void) { return 0; }
 int wf_par_balance(mpmc_sim sim, int every, double threshold) { return (void)sim, (void)every, (void)threshold, 0; }
 void wf_par_imbalance(mpmc_sim sim, double *imbalance, long *balances) {
   (void)sim;

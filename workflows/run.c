@@ -80,6 +80,7 @@ typedef struct {
  * workflow calls between steps), not only to mpmc_sim_step: on a busy machine a single
  * region with more threads than free cores costs more than the whole step. */
 static void set_threads(wf_run *w) {
+  if (w->sc.threads == 0) w->sc.threads = wf_par_threads(); /* over MPI: the node shared */
 #ifdef _OPENMP
   if (w->sc.threads > 0) {
     w->saved_threads = omp_get_max_threads();

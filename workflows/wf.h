@@ -423,6 +423,10 @@ void wf_par_xsum(wf_xsum *s, int n);
 /* A simulation over the run's ranks; one read back from a checkpoint over them. */
 int wf_par_sim_create(mpmc_context ctx, int dim, mpmc_sim *sim);
 int wf_par_checkpoint_read(mpmc_context ctx, const char *path, mpmc_sim *sim, char **meta);
+/* The threads a rank takes where the scene leaves them open (threads: 0): over MPI without
+ * OMP_NUM_THREADS, the node's cores shared among the ranks on it, at most the cores this
+ * rank may run on, at least 1; else 0, OpenMP's default (collective). */
+int wf_par_threads(void);
 /* The log's line on the decomposition ("" in one process). */
 void wf_par_plan(mpmc_sim sim, char *line, size_t len);
 /* The scene's load_balance over MPI (mpmc_sim_set_mpi_balance); nothing in one process.
