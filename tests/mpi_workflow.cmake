@@ -100,7 +100,7 @@ if(CMAKE_SCRIPT_MODE_FILE)
   if(NOT ranks EQUAL NP)
     message(FATAL_ERROR "summary.json over ${NP} ranks says ranks = ${ranks}")
   endif()
-  if(CHECK_THREADS) # threads: 0 without OMP_NUM_THREADS: the node's cores shared among its ranks
+  if(DEFINED ENV{MPMC_CHECK_THREADS}) # threads: 0, no OMP_NUM_THREADS: the node's cores shared
     execute_process(COMMAND getconf _NPROCESSORS_ONLN OUTPUT_VARIABLE cores OUTPUT_STRIP_TRAILING_WHITESPACE)
     execute_process(COMMAND nproc OUTPUT_VARIABLE mine OUTPUT_STRIP_TRAILING_WHITESPACE)
     math(EXPR want "${cores} / ${NP}")
@@ -160,14 +160,9 @@ foreach(np 2 3 4)
 endforeach()
 # threads left open (column_2d sets none) and no OMP_NUM_THREADS: each of 3 ranks takes its
 # share of the node's cores, at least 1, not all of them (3 x 2 threads on 2 cores before)
-add_test(NAME mpmc-mpi-threads-np3
-  COMMAND ${CMAKE_COMMAND} -DMPMC=$<TARGET_FILE:mpmc_cli> -DMPIEXEC=${MPIEXEC_EXECUTABLE}
-    -DMPIEXEC_NUMPROC_FLAG=${MPIEXEC_NUMPROC_FLAG} "-DMPIEXEC_FLAGS=${MPMC_MPIEXEC_FLAGS}" -DNP=3
-    -DSCENE=${PROJECT_SOURCE_DIR}/workflows/column_2d.yaml "-DKEYS=tip_displacement_y" -DRTOL=1e-9
-    -DATOL=1e-12 -DCHECK_THREADS=1 -DOUT=${CMAKE_CURRENT_BINARY_DIR}/mpi-out/threads-np3
-    -P ${CMAKE_CURRENT_SOURCE_DIR}/mpi_workflow.cmake)
-set_tests_properties(mpmc-mpi-threads-np3 PROPERTIES LABELS "mpi" PROCESSORS 3
-  ENVIRONMENT "${MPMC_MPIEXEC_ENV}" ENVIRONMENT_MODIFICATION "OMP_NUM_THREADS=unset:" TIMEOUT 900)
+mpmc_mpi_scene_test(threads 3 column_2d.yaml "tip_displacement_y" 1e-9 1e-12 "")
+set_tests_properties(mpmc-mpi-threads-np3 PROPERTIES ENVIRONMENT "${MPMC_MPIEXEC_ENV};MPMC_CHECK_THREADS=1"
+  ENVIRONMENT_MODIFICATION "OMP_NUM_THREADS=unset:")
 # the dam break's centre of mass, surge front and hydrostatic error: exact sums and maxima
 # over each rank's own points (no point gathered), the same bits as in one process
 foreach(np 2 3 4)
