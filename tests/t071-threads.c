@@ -104,6 +104,16 @@ static void test_3d_fbar(void **state) {
   check(3, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2, 0);
 }
 
+/* the anchored default, whose G2P kernels are its own (g2p.c: FB 5 and 7) */
+static void test_2d_anchored(void **state) {
+  (void)state;
+  check(2, MPMC_FBAR_ANCHORED, MPMC_BASIS_LINEAR, 0);
+}
+static void test_3d_anchored(void **state) {
+  (void)state;
+  check(3, MPMC_FBAR_ANCHORED, MPMC_BASIS_UGIMP, 0);
+}
+
 /* the stable form scatters onto the 2h grid: supports one node wider than the basis' */
 static void test_3d_ugimp_stable(void **state) {
   (void)state;
@@ -111,10 +121,11 @@ static void test_3d_ugimp_stable(void **state) {
 }
 
 /* a body too small for the slabs' colours: per-thread grids in P2G and in G2P's F-bar
- * scatter (Algorithm 1 and the stable form), without F-bar in P2G alone */
+ * scatter (Algorithm 1, the anchored and the stable form), without F-bar in P2G alone */
 static void test_3d_compact(void **state) {
   (void)state;
   check(3, MPMC_FBAR_PAPER, MPMC_BASIS_BSPLINE2, 1);
+  check(3, MPMC_FBAR_ANCHORED, MPMC_BASIS_BSPLINE3, 1);
   check(3, MPMC_FBAR_STABLE, MPMC_BASIS_UGIMP, 1);
   check(3, MPMC_FBAR_OFF, MPMC_BASIS_LINEAR, 1);
 }
@@ -349,7 +360,8 @@ static void test_index_order(void **state) {
 
 int main(void) {
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_2d_fbar), cmocka_unit_test(test_2d_ugimp_total),
-                                     cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_3d_ugimp_stable), cmocka_unit_test(test_3d_compact),
+                                     cmocka_unit_test(test_3d_fbar), cmocka_unit_test(test_2d_anchored),
+                                     cmocka_unit_test(test_3d_anchored), cmocka_unit_test(test_3d_ugimp_stable), cmocka_unit_test(test_3d_compact),
                                      cmocka_unit_test(test_slab_order), cmocka_unit_test(test_slab_groups),
                                      cmocka_unit_test(test_index_order)};
   return cmocka_run_group_tests(tests, NULL, NULL);
