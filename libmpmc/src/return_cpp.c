@@ -68,7 +68,7 @@ static void lapack_open(void) {
     return;
   }
   /* OpenBLAS (the pthread flavour behind Debian's liblapack.so.3) would start its own
-     threads inside our OpenMP regions: one thread (TOOLCHAIN.md) */
+     threads inside our OpenMP regions: one thread */
   set_threads_fn st = NULL;
   if (!sym(lapack.handle, "openblas_set_num_threads", &st, sizeof st))
     sym(RTLD_DEFAULT, "openblas_set_num_threads", &st, sizeof st);

@@ -140,8 +140,8 @@ static int kinsol_init(mpmc_rm_ws *ws) {
          KINSetUserData(ws->kmem, &ws->prob) == KIN_SUCCESS &&
          KINSetLinearSolver(ws->kmem, ws->LS, ws->A) == KIN_SUCCESS &&
          KINSetJacFn(ws->kmem, kin_jac) == KIN_SUCCESS &&
-         /* a fresh Jacobian every iteration (TOOLCHAIN.md: the default reuse of 10 makes a
-            scalar Newton fail) */
+         /* a fresh Jacobian every iteration (KINSOL's default reuse of 10 makes a scalar
+            Newton fail) */
          KINSetMaxSetupCalls(ws->kmem, 1) == KIN_SUCCESS &&
          KINSetNumMaxIters(ws->kmem, MPMC_RM_MAX_ITERS) == KIN_SUCCESS &&
          KINSetConstraints(ws->kmem, ws->constraints) == KIN_SUCCESS &&

@@ -586,7 +586,7 @@ static int mc_kin_get(mpmc_rm_ws *ws, mc_kin **out) {
          KINSetUserData(k->kmem, k) == KIN_SUCCESS &&
          KINSetLinearSolver(k->kmem, k->LS, k->A) == KIN_SUCCESS &&
          KINSetJacFn(k->kmem, mc_kin_jac) == KIN_SUCCESS &&
-         /* a fresh Jacobian every iteration (TOOLCHAIN.md) */
+         /* a fresh Jacobian every iteration (return_map.c: KINSOL's default reuse fails) */
          KINSetMaxSetupCalls(k->kmem, 1) == KIN_SUCCESS &&
          KINSetNumMaxIters(k->kmem, MC_MAX_ITERS) == KIN_SUCCESS &&
          /* fscale = 1/tol: fnormtol 1 means |R| <= tol */
