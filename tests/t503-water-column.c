@@ -85,8 +85,8 @@ static void test_hydrostatic_fbar(void **state) {
   double rmss, vrmss;
   run(MPMC_FBAR_STABLE, &rmss, &vrmss);
   if (getenv("MPMC_TEST_VERBOSE"))
-    printf("water column: pressure RMS %.3f%% (F-bar total), %.3f%% (stable), %.3f%% (standard)\n",
-           100 * rms, 100 * rmss, 100 * rms0);
+    printf("water column: pressure RMS %.3f%% (F-bar total), %.3f%% (stable), %.3f%% (standard); "
+           "RMS speed %.3g, %.3g, %.3g m/s\n", 100 * rms, 100 * rmss, 100 * rms0, vrms, vrmss, vrms0);
   if (vrmss > 1e-3 || rmss > 0.02)
     fail_msg("F-bar, stable form: RMS speed %.3g m/s, pressure RMS error %.3f%% (expected at rest "
              "within 2%%)", vrmss, 100 * rmss);

@@ -81,7 +81,7 @@ static int step_phases(mpmc_sim sim, double dt, double *t) {
   }
   if (sim->cfg.fbar) PHASE(sim, MPMC_PHASE_FBAR, t, k->fbar(sim, 1)); /* dF -> dF-bar (Alg. 1, 2-4)   */
   PHASE(sim, MPMC_PHASE_STRESS, t, mpmc_stress_update(sim, dt)); /* material update, dF(-bar);
-                                   the built-in materials run F-bar's gather themselves */
+                                   those with gathers_fbar run F-bar's gather themselves */
   if (sim->bodies) { /* no point inside a body (sums over the ranks) */
     AGREE(sim, MPMC_PHASE_STRESS, t);
     PHASE(sim, MPMC_PHASE_CHECKS, t, mpmc_contact_check(sim));

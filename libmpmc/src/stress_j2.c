@@ -1,6 +1,6 @@
 /* The Hencky-J2 stress update over blocks of four points (issue 6: "materials called over
- * batches"), one of the kernel files compiled for baseline x86-64 and for AVX2
- * (mpmc_impl.h, MPMC_ISA).
+ * batches"), one of the kernel files compiled for each instruction set: baseline x86-64,
+ * AVX2, AVX2 with fused multiply-adds and AVX-512 (mpmc_impl.h, MPMC_ISA).
  *
  * Most points of a slope or a column are elastic in a given step: their trial state
  * b = dF b_e dF^T, its Hencky strain by the series of linalg.h (mpmc_sym3_log_series), the
@@ -8,12 +8,15 @@
  * every point, so four neighbouring points go through them at once in vectors of four
  * doubles (one AVX2 register, two SSE2 ones).  The series takes the degree the largest
  * strain of the four needs (the terms beyond a point's own degree are below its 2^-54
- * tolerance).  A plastic point continues alone from its trial state (the scalar solve and
- * b_e, mpmc_j2_plastic); one whose strain is too large for the series, or not finite, goes
+ * tolerance).  With the auto solver a block's plastic points go on together from their trial
+ * states (plastic4: the scalar solve's operations lane by lane); a lane that the vectors
+ * cannot finish, and every plastic point with the newton or kinsol solver, continues alone
+ * (the scalar solve and b_e, mpmc_j2_plastic); one whose strain is too large for the series, or not finite, goes
  * to the scalar return map (material_hencky_j2.c, mpmc_j2_return_map) from its unchanged
  * inputs; points of other materials in a block are masked out.  The blocks are
  * fixed by the point index (points 4k .. 4k+3), so the results do not depend on the thread
- * count, and the two instruction sets give the same bits (ISO C: no contraction). */
+ * count; baseline and AVX2 give the same bits (ISO C: no contraction), as do the fused
+ * sets, fma and avx512, between themselves. */
 #include <limits.h>
 #include <math.h>
 #include <stdint.h>
