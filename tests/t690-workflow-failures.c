@@ -147,7 +147,8 @@ static void test_forced_blowup(void **state) {
 /* A coarse dam break (h = 0.5 m, 2x2 points per cell, K = 2 GPa) with the stable F-bar form:
  * the points' own J drift in the surge (0.7-1.3 by t = 1 s), the stable form projects them,
  * and the run-up at the far wall blows up at t = 1.02 s; the monitor's message names the
- * form and the way out, Algorithm 1, with which the same scene runs past that time. */
+ * form and the way out, the default (anchored) form, with which the same scene runs past that
+ * time. */
 static const char *flow_fmt =
     "dim: 2\n"
     "plots: false\n"
@@ -173,18 +174,18 @@ static void test_total_form_flow(void **state) {
   (void)state;
   char scene[] = DIR "/flow.yaml", out[] = DIR "/out-flow", msg[4096];
   mkdir(DIR, 0777);
-  for (int paper = 0; paper < 2; ++paper) {
+  for (int dflt = 0; dflt < 2; ++dflt) {
     FILE *f = fopen(scene, "w");
     assert_non_null(f);
-    fprintf(f, flow_fmt, paper ? "true" : "stable");
+    fprintf(f, flow_fmt, dflt ? "true" : "stable");
     fclose(f);
     const int e = run_lib(scene, out, msg, sizeof msg);
-    if (paper) {
-      if (e) fail_msg("dam break with Algorithm 1: expected to complete, got %d: %s", e, msg);
+    if (dflt) {
+      if (e) fail_msg("dam break with the default form: expected to complete, got %d: %s", e, msg);
     } else {
       if (e != MPMC_ERR_UNSTABLE) fail_msg("dam break, stable form: expected MPMC_ERR_UNSTABLE, got %d: %s", e, msg);
       test_expect_in("flow", msg, "kinetic energy grows without input");
-      test_expect_in("flow", msg, "use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene 'fbar: true')");
+      test_expect_in("flow", msg, "use the default F-bar form (MPMC_FBAR_ANCHORED, scene 'fbar: true')");
       test_expect_in("flow", msg, "the stable form projects the points' own J");
       /* the whole report survives: the way back and where the failing state went (a
          1024-byte buffer cut this message inside its last sentence) */

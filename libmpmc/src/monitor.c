@@ -187,9 +187,9 @@ int mpmc_monitor_step(mpmc_sim sim) {
   if (sim->cfg.fbar == MPMC_FBAR_TOTAL || sim->cfg.fbar == MPMC_FBAR_STABLE) {
     const double jmin = -jr[0], jmax = jr[1];
     snprintf(hint, sizeof hint,
-             "; or, in a large flow, use Algorithm 1 (F-bar form MPMC_FBAR_PAPER, scene "
-             "'fbar: true'): the %s form projects the points' own J, which drift in a flow "
-             "(here %.3g to %.3g)",
+             "; or, in a large flow, use the default F-bar form (MPMC_FBAR_ANCHORED, scene "
+             "'fbar: true'), which follows Algorithm 1 where the points move: the %s form "
+             "projects the points' own J, which drift in a flow (here %.3g to %.3g)",
              sim->cfg.fbar == MPMC_FBAR_TOTAL ? "total" : "stable", jmin, jmax);
   }
   return MPMC_ERROR(sim->ctx, MPMC_ERR_UNSTABLE,
