@@ -515,9 +515,12 @@ static void drop(void *a) {
   *pa = NULL;
 }
 
-/* The state's arrays for the sim's form, and the points' Jbar (J where F-bar starts with the
- * run) and, for the anchored form, Janc (anchored to the Jbar at hand); what the form does
- * not use freed. */
+/* The state's arrays for the sim's form, and the points' Jbar and, for the anchored form,
+ * Janc (anchored to the Jbar at hand); what the form does not use freed.  Without F-bar the
+ * materials integrate the points' own dF, so Jbar, which no step then updates, is freed as
+ * well: F-bar switched on (with the run or again later) starts from Jbar = J, the Jacobian
+ * the material state has (a Jbar kept from before the switch off projected the volume change
+ * of the steps without F-bar a second time, a jump in the volumetric strain). */
 int mpmc_fbar_prepare(mpmc_sim sim) {
   mpmc_context ctx = sim->ctx;
   mpmc_particles *p = &sim->p;
@@ -547,6 +550,7 @@ int mpmc_fbar_prepare(mpmc_sim sim) {
     drop(&f->xnode);
   }
   if (!form) {
+    drop(&p->Jbar);
     drop(&f->scale);
     f->cap_scale = 0;
     f->cap = 0;
