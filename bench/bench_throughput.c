@@ -21,7 +21,13 @@
  * machine's drift, slow against a round, cancels in a pair).  Printed per form: the median
  * and range of the R shares; the share from the best rate of each (the runs least disturbed
  * by other load, on a busy host the steadier figure); each phase's least ms a step over the
- * rounds, off and on, and their sums' ratio (each phase at its least disturbed round). */
+ * rounds, off and on, and their sums' ratio (each phase at its least disturbed round).  With
+ * MPMC_BENCH_PAIRED=B set, the same forms are measured with two simulations each, without and
+ * with F-bar, stepped in turn [steps] steps at a time for B pairs of blocks; the first step of
+ * a block, which brings the simulation's data back into the caches, is not timed, the others
+ * are timed one by one, and the least, lower-quartile and median step without and with
+ * F-bar are compared: the two alternate within a fraction of a second, so that the host's
+ * drift does not separate them, and a step's least time is its least disturbed one. */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -51,12 +57,11 @@ static double now(void) {
     }                                                                                      \
   } while (0)
 
-/* returns particle-steps per second; *np the number of points */
-static double run(int scene, int basis, int fbar, int j2, int threads, int steps, double scale,
-                  int *np) {
-  mpmc_context ctx;
+/* The scene (0 block, 1 column) in ctx, stepped 3 times (the warm-up: allocations);
+ * *np the number of points, *dtp the step */
+static mpmc_sim scene_sim(mpmc_context ctx, int scene, int basis, int fbar, int j2, int threads,
+                          double scale, int *np, double *dtp) {
   mpmc_sim sim;
-  mpmc_context_create(&ctx);
   CHECK(mpmc_sim_create(ctx, 3, &sim));
   double h, lo[3] = {0, 0, 0}, hi[3], blo[3] = {0, 0, 0}, bhi[3];
   if (scene == 0) { /* block */
@@ -108,6 +113,17 @@ static double run(int scene, int basis, int fbar, int j2, int threads, int steps
   double dt;
   CHECK(mpmc_sim_stable_dt(sim, 0.3, &dt));
   for (int s = 0; s < 3; ++s) CHECK(mpmc_sim_step(sim, dt)); /* warm-up: allocations */
+  *dtp = dt;
+  return sim;
+}
+
+/* returns particle-steps per second; *np the number of points */
+static double run(int scene, int basis, int fbar, int j2, int threads, int steps, double scale,
+                  int *np) {
+  mpmc_context ctx;
+  mpmc_context_create(&ctx);
+  double dt;
+  mpmc_sim sim = scene_sim(ctx, scene, basis, fbar, j2, threads, scale, np, &dt);
   mpmc_stats st0, st1;
   CHECK(mpmc_sim_get_stats(sim, &st0));
   const double t0 = now();
@@ -130,19 +146,21 @@ static int cmp_double(const void *a, const void *b) {
   return (x > y) - (x < y);
 }
 
+/* The forms whose share MPMC_BENCH_SHARE and MPMC_BENCH_PAIRED measure */
+static const struct {
+  int basis, fbar;
+  const char *name;
+} forms[] = {{MPMC_BASIS_LINEAR, MPMC_FBAR_ANCHORED, "linear anchored"},
+             {MPMC_BASIS_BSPLINE2, MPMC_FBAR_ANCHORED, "bspline2 anchored"},
+             {MPMC_BASIS_UGIMP, MPMC_FBAR_ANCHORED, "ugimp anchored"},
+             {MPMC_BASIS_BSPLINE3, MPMC_FBAR_ANCHORED, "bspline3 anchored"},
+             {MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, "bspline2 paper"},
+             {MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, "bspline2 stable"},
+             {MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, "ugimp stable"}};
+enum { NF = sizeof forms / sizeof forms[0] };
+
 /* MPMC_BENCH_SHARE: F-bar's share, off and on alternated in rounds (see the file's comment) */
 static void fbar_shares(int rounds, int steps, double scale) {
-  static const struct {
-    int basis, fbar;
-    const char *name;
-  } forms[] = {{MPMC_BASIS_LINEAR, MPMC_FBAR_ANCHORED, "linear anchored"},
-               {MPMC_BASIS_BSPLINE2, MPMC_FBAR_ANCHORED, "bspline2 anchored"},
-               {MPMC_BASIS_UGIMP, MPMC_FBAR_ANCHORED, "ugimp anchored"},
-               {MPMC_BASIS_BSPLINE3, MPMC_FBAR_ANCHORED, "bspline3 anchored"},
-               {MPMC_BASIS_BSPLINE2, MPMC_FBAR_PAPER, "bspline2 paper"},
-               {MPMC_BASIS_BSPLINE2, MPMC_FBAR_STABLE, "bspline2 stable"},
-               {MPMC_BASIS_UGIMP, MPMC_FBAR_STABLE, "ugimp stable"}};
-  enum { NF = sizeof forms / sizeof forms[0] };
   double *sh = malloc(sizeof(double) * (size_t)rounds * NF), best[NF][2] = {{0}};
   double least[NF][2][MPMC_PHASE_COUNT + 1];
   if (!sh) return;
@@ -188,6 +206,59 @@ static void fbar_shares(int rounds, int steps, double scale) {
            100 * (sum[1] / sum[0] - 1.0));
   }
   free(sh);
+}
+
+/* q-quantile of v[0 .. n - 1], sorted in place (the lower of the two middle values) */
+static double quantile(double *v, int n, double q) {
+  qsort(v, (size_t)n, sizeof *v, cmp_double);
+  return v[(int)(q * (n - 1))];
+}
+
+/* MPMC_BENCH_PAIRED: F-bar's share from two simulations per form, without and with F-bar,
+ * stepped in turn `steps` steps at a time for `blocks` pairs of blocks (see the file's
+ * comment) */
+static void fbar_paired(int blocks, int steps, double scale) {
+  printf("F-bar's share of the step on the column, one thread, the simulations without and "
+         "with F-bar stepped in turn %d steps at a time, %d pairs (least, lower quartile and "
+         "median step, off -> on):\n", steps, blocks);
+  const int per = steps - 1; /* timed steps a block: the first brings its data back */
+  double *t[2];
+  t[0] = malloc(sizeof(double) * (size_t)blocks * (size_t)(per > 0 ? per : 1));
+  t[1] = malloc(sizeof(double) * (size_t)blocks * (size_t)(per > 0 ? per : 1));
+  if (!t[0] || !t[1] || per < 1) {
+    free(t[0]), free(t[1]);
+    return;
+  }
+  for (int f = 0; f < NF; ++f) {
+    mpmc_context ctx;
+    mpmc_context_create(&ctx);
+    int np, nt[2] = {0, 0};
+    double dt[2];
+    mpmc_sim sim[2] = {scene_sim(ctx, 1, forms[f].basis, 0, 1, 1, scale, &np, &dt[0]),
+                       scene_sim(ctx, 1, forms[f].basis, forms[f].fbar, 1, 1, scale, &np, &dt[1])};
+    for (int b = 0; b < blocks; ++b)
+      for (int k = 0; k < 2; ++k) {
+        const int on = (b + k) % 2; /* off first in even pairs, on first in odd ones */
+        CHECK(mpmc_sim_step(sim[on], dt[on]));
+        for (int s = 0; s < per; ++s) {
+          const double t0 = now();
+          CHECK(mpmc_sim_step(sim[on], dt[on]));
+          t[on][nt[on]++] = now() - t0;
+        }
+      }
+    for (int k = 0; k < 2; ++k) mpmc_sim_destroy(&sim[k]);
+    mpmc_context_destroy(&ctx);
+    const double qs[3] = {0.0, 0.25, 0.5};
+    printf("  %-16s", forms[f].name);
+    for (int i = 0; i < 3; ++i) {
+      const double a = quantile(t[0], nt[0], qs[i]), c = quantile(t[1], nt[1], qs[i]);
+      printf(" %s %.3f -> %.3f ms %+6.1f %%", i == 0 ? "least" : i == 1 ? "quartile" : "median",
+             1e3 * a, 1e3 * c, 100 * (c / a - 1.0));
+    }
+    printf("\n");
+    fflush(stdout);
+  }
+  free(t[0]), free(t[1]);
 }
 
 int main(int argc, char **argv) {
@@ -244,5 +315,7 @@ int main(int argc, char **argv) {
   }
   const char *share = getenv("MPMC_BENCH_SHARE");
   if (share && atoi(share) > 0) fbar_shares(atoi(share), steps, scale);
+  const char *paired = getenv("MPMC_BENCH_PAIRED");
+  if (paired && atoi(paired) > 0) fbar_paired(atoi(paired), steps, scale);
   return 0;
 }
