@@ -16,6 +16,7 @@
 #include <cmocka.h>
 #include <hdf5.h>
 
+#include "mpmc_impl.h" /* the run monitor's state */
 #include "test_util.h"
 
 #define CK MPMC_BINARY_DIR "/t602.ck"
@@ -123,6 +124,38 @@ static void test_restart_bitwise(void **state) {
   TCALL(mpmc_sim_get_particle_set(b, id, &name, &n, &idx));
   assert_int_equal(n, 2);
   assert_int_equal(idx[1], 3);
+  mpmc_sim_destroy(&a);
+  mpmc_sim_destroy(&b);
+}
+
+/* The kernel set the steps ran and the run monitor's setting travel with the checkpoint: a
+ * run on the baseline kernels (round-off apart from the default fma or avx512 set where the
+ * processor has AVX2) restarts on them, bit for bit, and a monitor turned off stays off. */
+static void test_restart_settings(void **state) {
+  (void)state;
+  const char *env = getenv("MPMC_KERNELS");
+  if (env && *env) skip(); /* the environment's choice wins over the file's */
+  const int N = 20;
+  mpmc_sim a = build(1), b = build(1);
+  double dt;
+  TCALL(mpmc_sim_stable_dt(a, 0.3, &dt));
+  for (int k = 0; k < 2; ++k) {
+    TCALL(mpmc_sim_set_kernels(k ? b : a, MPMC_KERNELS_BASELINE));
+    TCALL(mpmc_sim_set_energy_monitor(k ? b : a, -1.0));
+  }
+  for (int s = 0; s < N; ++s) TCALL(mpmc_sim_step(a, dt));
+  for (int s = 0; s < N / 2; ++s) TCALL(mpmc_sim_step(b, dt));
+  TCALL(mpmc_sim_checkpoint_write(b, CK, NULL));
+  mpmc_sim_destroy(&b);
+  TCALL(mpmc_sim_checkpoint_read(ctx, CK, &b, NULL));
+  mpmc_kernels kb;
+  TCALL(mpmc_sim_get_kernels(b, &kb));
+  if (kb != MPMC_KERNELS_BASELINE)
+    fail_msg("restarted on the %s kernels, the run's were baseline", mpmc_kernels_name(kb));
+  if (!(b->monitor.factor < 0.0))
+    fail_msg("the energy check, off in the run, is %g after the restart", b->monitor.factor);
+  for (int s = 0; s < N / 2; ++s) TCALL(mpmc_sim_step(b, dt));
+  compare(a, b);
   mpmc_sim_destroy(&a);
   mpmc_sim_destroy(&b);
 }
@@ -259,6 +292,7 @@ int main(void) {
   test_ctx = ctx;
   const struct CMUnitTest tests[] = {cmocka_unit_test(test_killed_writer),
                                      cmocka_unit_test(test_restart_bitwise),
+                                     cmocka_unit_test(test_restart_settings),
                                      cmocka_unit_test(test_bad_files)};
   const int r = cmocka_run_group_tests(tests, NULL, NULL);
   mpmc_context_destroy(&ctx);

@@ -1,6 +1,7 @@
 /* Checkpoint and restart: one HDF5 file holding everything needed to continue a run
- * bit for bit (configuration, grid, materials, every allocated particle array, walls,
- * particle sets, run statistics and the caller's text).  Written atomically: the file is
+ * bit for bit (configuration with the kernel set and the run monitor's state, grid,
+ * materials, every allocated particle array, walls, particle sets, run statistics and the
+ * caller's text).  Written atomically: the file is
  * built as path.tmp, flushed and fsync'ed, then renamed over path, so a process killed
  * during the write leaves the previous checkpoint intact.
  *
@@ -202,6 +203,22 @@ static herr_t write_adaptive_nodes(hid_t g, mpmc_const_sim sim) {
   return st;
 }
 
+/* The run monitor's state (mpmc_monitor) as doubles, and back (the steps exact below 2^53) */
+enum { MONITOR_DOUBLES = 16 };
+static void monitor_pack(const mpmc_monitor *m, double *d) {
+  d[0] = m->factor, d[1] = (double)m->base_step, d[2] = m->e0[0], d[3] = m->e0[1];
+  d[4] = m->gx0, d[5] = m->fx0;
+  memcpy(d + 6, m->sig, sizeof m->sig);
+  d[14] = m->ke_last, d[15] = (double)m->next_check;
+}
+static void monitor_unpack(const double *d, mpmc_monitor *m) {
+  m->factor = d[0], m->base_step = (int64_t)d[1], m->e0[0] = d[2], m->e0[1] = d[3];
+  m->gx0 = d[4], m->fx0 = d[5];
+  memcpy(m->sig, d + 6, sizeof m->sig);
+  m->ke_last = d[14], m->next_check = (int64_t)d[15];
+}
+_Static_assert(sizeof(((mpmc_monitor *)0)->sig) == 8 * sizeof(double), "monitor_pack's layout");
+
 static int write_config(hid_t f, mpmc_const_sim sim) {
   hid_t g = H5Gcreate2(f, "config", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) return -1;
@@ -258,6 +275,12 @@ static int write_config(hid_t f, mpmc_const_sim sim) {
   }
   st |= mpmc_h5_attr_write(g, "sort_interval_last", H5T_NATIVE_INT64, 2, sort);
   st |= mpmc_h5_attr_write(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
+  /* the kernel set the steps ran (the same on every rank), and the run monitor's setting and
+   * state (global sums, the same on every rank), so that a restart checks as the run would */
+  st |= mpmc_h5_attr_write(g, "kernels", H5T_NATIVE_INT, 1, &sim->cfg.kernels);
+  double mon[MONITOR_DOUBLES];
+  monitor_pack(&sim->monitor, mon);
+  st |= mpmc_h5_attr_write(g, "monitor", H5T_NATIVE_DOUBLE, MONITOR_DOUBLES, mon);
   const mpmc_water_table *wt = &sim->wt; /* kind, gamma_w, plane; the polyline's vertices */
   if (wt->kind != MPMC_WATER_NONE) {
     const double w[5] = {wt->kind, wt->gamma_w, wt->plane[0], wt->plane[1], wt->plane[2]};
@@ -400,6 +423,11 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
   int axes[2] = {-1, 0}; /* absent in files of before: no sort for an axis change until the next */
   if (H5Aexists(g, "sort_axis_slab_axis") > 0)
     st |= mpmc_h5_attr_read(g, "sort_axis_slab_axis", H5T_NATIVE_INT, 2, axes);
+  int kernels = MPMC_KERNELS_AUTO; /* absent in files of before: the process's choice */
+  if (H5Aexists(g, "kernels") > 0) st |= mpmc_h5_attr_read(g, "kernels", H5T_NATIVE_INT, 1, &kernels);
+  const int has_mon = H5Aexists(g, "monitor") > 0; /* absent: the default, a new baseline */
+  double mon[MONITOR_DOUBLES];
+  if (has_mon) st |= mpmc_h5_attr_read(g, "monitor", H5T_NATIVE_DOUBLE, MONITOR_DOUBLES, mon);
   H5Gclose(g);
   MPMC_CHECK(st >= 0, ctx, MPMC_ERR_FORMAT, "checkpoint /config: missing or malformed attributes");
   MPMC_CHECK(ints[0] == sim->cfg.dim, ctx, MPMC_ERR_FORMAT,
@@ -446,6 +474,21 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
              MPMC_ERR_FORMAT, "checkpoint /config: bad sort_axis_slab_axis = [%d, %d]", axes[0], axes[1]);
   sim->sort_axis = axes[0];
   sim->scr.slab_axis = axes[1];
+  /* the steps' kernel set where this processor runs it, unless MPMC_KERNELS asks for one
+   * (mpmc_sim_create applied it); the sets differ by round-off (mpmc_sim_set_kernels) */
+  const char *ke = getenv("MPMC_KERNELS");
+  const int runs = kernels == MPMC_KERNELS_BASELINE ||
+                   ((kernels == MPMC_KERNELS_AVX2 || kernels == MPMC_KERNELS_FMA) &&
+                    mpmc_kernels_avx2_available()) ||
+                   (kernels == MPMC_KERNELS_AVX512 && mpmc_kernels_avx512_available());
+  if (!(ke && *ke) && runs) MPMC_CALL(mpmc_sim_set_kernels(sim, kernels));
+  if (has_mon) {
+    MPMC_CHECK(isfinite(mon[0]) && (mon[0] > 1.0 || mon[0] <= 0.0) && mon[1] >= 0.0 &&
+                   mon[1] <= (double)stats[0] && mon[15] >= 0.0,
+               ctx, MPMC_ERR_FORMAT, "checkpoint /config: bad monitor = [%g, %g, ..., %g]",
+               mon[0], mon[1], mon[15]);
+    monitor_unpack(mon, &sim->monitor);
+  }
   return read_rank_sort(f, sim);
 }
 
