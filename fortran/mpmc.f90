@@ -10,7 +10,9 @@
 !> Conventions that differ from ordinary Fortran, because they are C's:
 !>  - ids and point indices are 0-based (material ids, wall ids, `first`, particle sets);
 !>  - a particle field is x(ncomp, np) with column p the C row p-1 (no copy: it aliases the
-!>    library's storage and is valid until points are added or the simulation destroyed);
+!>    library's storage and is valid until points are added, the field goes with what needs it
+!>    (Jbar with F-bar set off, the pore pressure with the water table removed) or the
+!>    simulation is destroyed; over MPI borrow again after each step, which may migrate points);
 !>  - the relative deformation gradient handed to a user material is C row-major, so the
 !>    Fortran array dF(3,3) holds the transpose: F_ij = dF(j, i).
 !> Strings are ordinary character(*) in the wrappers; a few functions that live in other
@@ -1233,9 +1235,9 @@ contains
   end function mpmc_context_last_error
 
   ! ---- zero-copy arrays -------------------------------------------------------------------
-  ! A field pointer stays the field across steps and sorts until points are added; give it
-  ! back with mpmc_sim_restore_field when done: on loan, the velocity makes each step's
-  ! stability limit take a pass over the points and, with F-bar, the positions a copy.
+  ! A field pointer stays the field across steps and sorts until points are added (for the
+  ! other cases see the module's header); give it back with mpmc_sim_restore_field when done:
+  ! on loan, the velocity makes each step's stability limit take a pass over the points.
 
   function get_field_2d(sim, field, x) result(ierr)
     type(mpmc_sim), intent(in) :: sim

@@ -135,8 +135,9 @@ typedef enum {
   MPMC_PHASE_P2G = 2,     /* mass, momentum and forces onto the grid                     */
   MPMC_PHASE_GRID = 3,    /* grid velocities, walls, damping                             */
   MPMC_PHASE_G2P = 4,     /* velocities, deformation, positions (with F-bar's scatter)   */
-  MPMC_PHASE_FBAR = 5,    /* F-bar's nodal average and gather (Hencky-J2 alone: the
-                             gather runs in the material update, MPMC_PHASE_STRESS)      */
+  MPMC_PHASE_FBAR = 5,    /* F-bar's nodal average and gather (when every material is
+                             Hencky-J2, Hencky, Neo-Hookean or Newtonian the gather runs
+                             in the material update, MPMC_PHASE_STRESS)                  */
   MPMC_PHASE_STRESS = 6,  /* the material update                                         */
   MPMC_PHASE_CHECKS = 7,  /* stability limit, rigid bodies' contact, run monitor         */
   MPMC_PHASE_COUNT = 8
@@ -164,8 +165,9 @@ const char *mpmc_context_last_error(const mpmc_context ctx);
 int mpmc_context_get_last_error(const mpmc_context ctx, char *buf, int len);
 int mpmc_context_clear_error(mpmc_context ctx);
 int mpmc_context_get_last_code(const mpmc_context ctx, int *code);
-/* Record an error as the library does ("message [file:line]"); returns code.  For the
- * libraries and callbacks built on libmpmc. */
+/* Record an error as the library does ("<the code's mpmc_error_string>: message
+ * [file:line]"); returns code (MPMC_ERR_ARG if ctx or message is NULL).  For the libraries
+ * and callbacks built on libmpmc. */
 int mpmc_context_set_error(mpmc_context ctx, int code, const char *file, int line,
                            const char *message);
 int mpmc_context_set_log_level(mpmc_context ctx, mpmc_log_level level);
@@ -196,8 +198,8 @@ int mpmc_sim_set_damping(mpmc_sim sim, double alpha);
 int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on); /* 0 off, 1 on */
 /* Adaptive viscous damping for quasi-static stages (adaptive dynamic relaxation): nodal
  * velocities damped by c m v with c = 2 zeta omega, omega the lowest mode's frequency
- * estimated each step by a Rayleigh quotient over the grid; zeta in [0, 2], 1 critical,
- * 0 off (not over MPI yet).  get: the c [1/s] the next step applies. */
+ * estimated each step by a Rayleigh quotient over the grid (over MPI: summed over the
+ * ranks); zeta in [0, 2], 1 critical, 0 off.  get: the c [1/s] the next step applies. */
 int mpmc_sim_set_adaptive_damping(mpmc_sim sim, double zeta);
 int mpmc_sim_get_adaptive_damping(mpmc_const_sim sim, double *c);
 /* A water table: hydrostatic pore pressure p = gamma_w max(0, h - z) below the piezometric
@@ -309,7 +311,10 @@ int mpmc_sim_add_particles(mpmc_sim sim, int n, const double *x, const double *v
 int mpmc_sim_get_num_particles(mpmc_const_sim sim, int *n);
 /* Borrow a particle field in place (no copy); give it back with restore.  Fields a scene
  * does not have (e.g. EPS_P without a plastic material) are MPMC_ERR_STATE.  The pointer
- * stays the field across steps and sorts until points are added (the arrays may move).
+ * stays the field across steps and sorts until points are added (the arrays may move), and
+ * until the field goes with what needs it (JBAR at the first step after F-bar is set off,
+ * PORE_PRESSURE when the water table is removed); over MPI a step's migration may move every
+ * field, so borrow again after each step.
  * While the velocity is on loan (until its restore) the stability limit of each step takes a
  * pass over the points for max |v| instead of the one G2P found. */
 int mpmc_sim_get_field(mpmc_sim sim, mpmc_field field, double **data, int *ncomp);
@@ -317,8 +322,10 @@ int mpmc_sim_restore_field(mpmc_sim sim, mpmc_field field, double **data);
 int mpmc_sim_get_material_ids(mpmc_sim sim, const int **ids);
 /* Sorting the points by grid cell for locality (the transfers' caches): off by default, so
  * a point keeps the index it was added with.  With nsteps > 0 the step sorts every nsteps
- * steps (the first step too): every per-point array moves, particle sets are renumbered, and
- * ids[i] (get_particle_ids) is the index point i had when it was added, to follow a point.
+ * steps (the first step too), and once a tenth of the interval has passed also when the
+ * slabs' axis has changed since the last sort (a flattening body): every per-point array
+ * moves, particle sets are renumbered, and ids[i] (get_particle_ids) is the index point i had
+ * when it was added, to follow a point.
  * Field pointers stay valid (the arrays are permuted in place).  Results change only by the
  * summation order at the nodes; the sort does not depend on the thread count. */
 int mpmc_sim_set_sort_interval(mpmc_sim sim, int nsteps);
@@ -349,10 +356,12 @@ int mpmc_sim_add_wall_nodes(mpmc_sim sim, int set, mpmc_wall_kind kind, int axis
 int mpmc_sim_remove_wall(mpmc_sim sim, int id);
 
 /* ---- time stepping ---------------------------------------------------------- */
-/* dt = factor * h / max_p(c_p + |v_p|), c_p the p-wave speed (paper: factor 0.3-0.4). */
+/* dt = factor * h / (max_m c_m + max_p |v_p|), c_m the p-wave speed of material m, at most
+ * factor times the viscous limit h^2 rho / (2 mu) and the rigid bodies' contact limit
+ * (paper: factor 0.3-0.4). */
 int mpmc_sim_stable_dt(mpmc_sim sim, double factor, double *dt);
 /* One explicit step (paper Fig. 1 / Algorithm 1).  Refuses a dt above the stability limit
- * h / c unless mpmc_sim_set_force_dt(sim, 1). */
+ * (stable_dt with factor 1) with MPMC_ERR_UNSTABLE unless mpmc_sim_set_force_dt(sim, 1). */
 int mpmc_sim_step(mpmc_sim sim, double dt);
 int mpmc_sim_set_force_dt(mpmc_sim sim, int force);
 int mpmc_sim_get_time(mpmc_const_sim sim, double *t);
@@ -462,7 +471,7 @@ int mpmc_sim_add_material_user(mpmc_sim sim, mpmc_user_stress_fn fn, void *data,
                                double rho, double wave_speed, int *id);
 /* Borrow the user state of every point, [n][*nstate]: *nstate is the row length (that of the
  * user material with the most state); the points of `material` use the first entries of
- * their rows.  Valid until points are added. */
+ * their rows.  Valid until points are added or a user material with more state is. */
 int mpmc_sim_get_user_state(mpmc_sim sim, int material, double **state, int *nstate);
 
 /* ---- user yield surfaces (return_cpp.c) ------------------------------------------- */

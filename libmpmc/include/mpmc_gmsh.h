@@ -18,8 +18,8 @@ typedef enum {
 /* Mesh a .geo (or read a .msh) and add points for the physical group `region` (surface in
  * 2D, volume in 3D).  Points near the boundary physical groups (curves in 2D, surfaces in
  * 3D) and physical point groups become particle sets named after the groups, and node sets
- * of the grid nodes near them (for walls: mpmc_sim_add_wall_nodes).  On failure nothing is
- * added. */
+ * of the grid nodes near them (for walls: mpmc_sim_add_wall_nodes).  On failure no points
+ * are added (the sets of the groups added before a failing set stay). */
 int mpmc_seed_gmsh(mpmc_sim sim, const char *file, const char *region, mpmc_seed_mode mode, int ppc,
                    int material, int *first, int *count);
 

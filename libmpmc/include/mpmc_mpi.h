@@ -45,7 +45,9 @@ int mpmc_sim_get_mpi_traffic(mpmc_const_sim sim, double *halo_bytes, long *halo_
  * (0: never by count) or when the most points on a rank exceed threshold times the mean
  * (0: never by threshold; else >= 1), the cuts move to split the points evenly (whole cells,
  * slabs of 5 cells or more, clear of walls mirrored along the slab axis) and every point
- * goes to its new rank.  Off by default (0, 0): the slabs stay where the grid put them.
+ * goes to its new rank.  Off by default (0, 0): the slabs stay where the grid put them, but
+ * for a cut that walls mirrored along the slab axis come within reach of, which moves clear
+ * of them whenever the walls change.
  * The results change only by the order of the halo sums (docs/mpi.md).  Collective. */
 int mpmc_sim_set_mpi_balance(mpmc_sim sim, int every_n_steps, double threshold);
 /* The most points on a rank over the mean over the ranks (1: even), and the balances done

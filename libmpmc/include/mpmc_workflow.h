@@ -21,8 +21,9 @@ int mpmc_workflow_run(mpmc_context ctx, const char *scene, const char *outdir, i
 #define MPMC_WORKFLOW_CHECK 4 /* validate the scene and print the plan; run nothing     */
 #define MPMC_WORKFLOW_FOS 8   /* stop after the factor_of_safety stage (`mpmc fos`)     */
 /* Continue the run in outdir from its last checkpoint (`mpmc resume`); flags: QUIET.  A
- * finished run's checkpoint goes on once the scene has another stage or a later end for its
- * last one; with overrides (`mpmc resume DIR --set ...`) applied after the run's own. */
+ * finished run's checkpoint goes on once the scene has another stage, or a later end for its
+ * last one if that stage ended on its time (not on coming to rest); with overrides
+ * (`mpmc resume DIR --set ...`) applied after the run's own. */
 int mpmc_workflow_resume(mpmc_context ctx, const char *outdir, int flags);
 int mpmc_workflow_resume_set(mpmc_context ctx, const char *outdir, int noverride,
                              const char *const *overrides, int flags);

@@ -74,7 +74,8 @@ int mpmc_sim_add_material_user(mpmc_sim sim, mpmc_user_stress_fn fn, void *data,
  * @brief Borrow the user-material state of every point (no copy), layout [n][*nstate].
  *
  * The rows are as wide as the widest user material of the simulation; the points of
- * `material` use the first nstate entries of their rows.  Valid until points are added.
+ * `material` use the first nstate entries of their rows.  Valid until points are added or a
+ * user material with more state is.
  * @param material the id of a user material
  * @param[out] state the array p->ustate (NULL when no user material has state)
  * @param[out] nstate the row length (stride) of state

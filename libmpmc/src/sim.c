@@ -195,7 +195,8 @@ int mpmc_sim_set_kinetic_damping(mpmc_sim sim, int on) {
  *        grid update damps the nodal velocities with c m v, c = 2 zeta omega, omega the
  *        lowest mode's frequency estimated every step by a Rayleigh quotient of the nodal
  *        force's change over the nodal velocity (damping.c).  Combines with local and
- *        kinetic damping, but is meant alone.  Not over MPI yet.
+ *        kinetic damping, but is meant alone.  Over MPI the quotient's sums run over the
+ *        ranks.
  * @param zeta damping ratio of the estimated mode in [0, 2]: 1 critical (Underwood's
  *        choice), 0 off; any call restarts the estimate (no damping until the second step
  *        has measured one)
