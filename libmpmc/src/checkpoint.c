@@ -27,6 +27,7 @@
 
 #include "contact.h"
 #include "io_mpi.h"
+#include "kernels.h"
 #ifdef MPMC_HAVE_MPI
 #include "mpmc_mpi.h"
 #endif
@@ -474,14 +475,8 @@ static int read_config(hid_t f, mpmc_sim sim, ckpt_rows *k) {
              MPMC_ERR_FORMAT, "checkpoint /config: bad sort_axis_slab_axis = [%d, %d]", axes[0], axes[1]);
   sim->sort_axis = axes[0];
   sim->scr.slab_axis = axes[1];
-  /* the steps' kernel set where this processor runs it, unless MPMC_KERNELS asks for one
-   * (mpmc_sim_create applied it); the sets differ by round-off (mpmc_sim_set_kernels) */
-  const char *ke = getenv("MPMC_KERNELS");
-  const int runs = kernels == MPMC_KERNELS_BASELINE ||
-                   ((kernels == MPMC_KERNELS_AVX2 || kernels == MPMC_KERNELS_FMA) &&
-                    mpmc_kernels_avx2_available()) ||
-                   (kernels == MPMC_KERNELS_AVX512 && mpmc_kernels_avx512_available());
-  if (!(ke && *ke) && runs) MPMC_CALL(mpmc_sim_set_kernels(sim, kernels));
+  /* the steps' kernel set (the sets differ by round-off: mpmc_sim_set_kernels) */
+  MPMC_CALL(mpmc_kernels_restore(sim, kernels));
   if (has_mon) {
     MPMC_CHECK(isfinite(mon[0]) && (mon[0] > 1.0 || mon[0] <= 0.0) && mon[1] >= 0.0 &&
                    mon[1] <= (double)stats[0] && mon[15] >= 0.0,

@@ -46,14 +46,19 @@ static const char *kernels_missing(int request) {
 #endif
 }
 
+/* Whether a valid request (mpmc_kernels) can run in this build on this processor. */
+static int runs_here(int request) {
+  return request == MPMC_KERNELS_AUTO || request == MPMC_KERNELS_BASELINE ||
+         (request == MPMC_KERNELS_AVX512 ? mpmc_kernels_avx512_available()
+                                         : mpmc_kernels_avx2_available());
+}
+
 /* Take a valid request (mpmc_kernels): AVX2, FMA and AVX512 are refused where they cannot
  * run, the message naming the request as `what` says; AUTO becomes AVX512 where AVX-512 is
  * available, else FMA where AVX2 is, else BASELINE. */
 static int use_kernels(mpmc_sim s, int request, const char *what) {
   const int avx2 = mpmc_kernels_avx2_available(), avx512 = mpmc_kernels_avx512_available();
-  const int ok = request == MPMC_KERNELS_AUTO || request == MPMC_KERNELS_BASELINE ||
-                 (request == MPMC_KERNELS_AVX512 ? avx512 : avx2);
-  MPMC_CHECK(ok, s->ctx, MPMC_ERR_ARG, "%s: %s", what, kernels_missing(request));
+  MPMC_CHECK(runs_here(request), s->ctx, MPMC_ERR_ARG, "%s: %s", what, kernels_missing(request));
   s->cfg.kernels = request != MPMC_KERNELS_AUTO ? request
                : avx512                     ? MPMC_KERNELS_AVX512
                : avx2                       ? MPMC_KERNELS_FMA
@@ -86,6 +91,15 @@ int mpmc_kernels_from_env(mpmc_sim s) {
   char what[64];
   snprintf(what, sizeof what, "environment variable MPMC_KERNELS = %s", mpmc_kernels_name(req));
   return use_kernels(s, req, what);
+}
+
+/* A checkpoint's set (checkpoint.c): taken where it runs here, unless MPMC_KERNELS names a
+ * set (mpmc_sim_create applied it); otherwise, or for a value no set has, the sim's own. */
+int mpmc_kernels_restore(mpmc_sim s, int saved) {
+  const char *e = getenv("MPMC_KERNELS");
+  if ((e && *e) || saved < MPMC_KERNELS_AUTO || saved > MPMC_KERNELS_AVX512 || !runs_here(saved))
+    return MPMC_SUCCESS;
+  return use_kernels(s, saved, "the checkpoint's kernel set");
 }
 
 /**

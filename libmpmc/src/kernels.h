@@ -20,5 +20,7 @@ typedef struct {
 const mpmc_kernel_set *mpmc_kernels_of(const struct mpmc_sim_s *sim);
 /* the sim's set from MPMC_KERNELS (unset: auto), refused where it cannot run */
 int mpmc_kernels_from_env(struct mpmc_sim_s *sim);
+/* a checkpoint's set, where it runs and MPMC_KERNELS names none (kernels.c) */
+int mpmc_kernels_restore(struct mpmc_sim_s *sim, int saved);
 
 #endif
